@@ -1,0 +1,3 @@
+"""station: a terminal acquisition station for statistical robot calibration."""
+
+__version__ = "0.1.0"

@@ -1,0 +1,70 @@
+"""The ``station`` command line: parse, call the domain, print. Nothing else lives here.
+
+Each sub-command is a module in :mod:`station.commands` exposing ``add_parser(subparsers)``;
+``add_parser`` registers the arguments and sets ``func`` (called with the parsed namespace,
+returning the exit code). Command modules import heavy packages (numpy, scipy, textual) inside
+their functions so that ``station --help`` and the TUI's start stay fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import pkgutil
+import sys
+from collections.abc import Sequence
+
+from station import __version__
+from station.errors import StationError
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The full argument parser, with every module of :mod:`station.commands` registered."""
+    import station.commands as commands_package
+
+    parser = argparse.ArgumentParser(
+        prog="station",
+        description=(
+            "Acquisition station for robot calibration: repeatability, relative accuracy and "
+            "linearity by the 1990 NASA/KSC statistical method. Without a command it opens the "
+            "terminal user interface."
+        ),
+    )
+    parser.add_argument("--version", action="version", version=f"station {__version__}")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
+    modules = sorted(
+        info.name
+        for info in pkgutil.iter_modules(commands_package.__path__)
+        if not info.name.startswith("_")
+    )
+    for name in modules:
+        importlib.import_module(f"station.commands.{name}").add_parser(subparsers)
+    return parser
+
+
+_TOP_LEVEL_FLAGS = ("-h", "--help", "--version")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``station`` console script; returns the process exit code."""
+    arguments = list(sys.argv[1:] if argv is None else argv)
+    if not arguments or (arguments[0].startswith("-") and arguments[0] not in _TOP_LEVEL_FLAGS):
+        # The bare command (or only options such as --no-mouse) opens the TUI.
+        arguments = ["tui", *arguments]
+    parser = build_parser()
+    args = parser.parse_args(arguments)
+    try:
+        return int(args.func(args) or 0)
+    except StationError as error:
+        print(f"station: {error.message}", file=sys.stderr)
+        return error.exit_code
+    except KeyboardInterrupt:
+        print("station: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        # `station read ... | head` closes the pipe early; that is not an error.
+        return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
