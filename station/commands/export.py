@@ -1,0 +1,58 @@
+"""``station export FILE --csv [-o OUT]``: a session's cycles as tidy CSV."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from station.errors import StationError
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Register ``station export``."""
+    parser = subparsers.add_parser(
+        "export",
+        help="export a session's readings as CSV",
+        description=(
+            "Write a session's cycles as tidy CSV: cycle, channel, value, unit, status (ok or "
+            "'rejected: <reason>'), time, then raw value, zero offset and placement. Rejected "
+            "cycles stay in the export, marked. The session file is opened read-only."
+        ),
+    )
+    parser.add_argument("file", metavar="FILE", help="the session file (.jsonl)")
+    parser.add_argument(
+        "--csv", action="store_true", required=True, help="CSV output (the only format for now)"
+    )
+    parser.add_argument(
+        "-o", "--output", metavar="OUT", help="write to OUT instead of standard output"
+    )
+    parser.add_argument("--force", action="store_true", help="overwrite OUT when it exists")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Export; StationError for a missing session or an existing OUT without --force."""
+    from station.session.export import export_csv
+    from station.session.model import load_session
+
+    session = load_session(args.file, recover=False)
+    if session.torn is not None:
+        print(f"station: note: {session.torn.message}", file=sys.stderr)
+    if not args.output:
+        export_csv(session, sys.stdout)
+        return 0
+    out = Path(args.output)
+    if out.exists() and not args.force:
+        raise StationError(f"{out} exists; pass --force to overwrite it or choose another name")
+    partial = out.with_name(f".{out.name}.partial")
+    try:
+        with open(partial, "w", encoding="utf-8", newline="") as handle:
+            rows = export_csv(session, handle)
+        os.replace(partial, out)
+    except OSError as error:
+        partial.unlink(missing_ok=True)
+        raise StationError(f"cannot write {out}: {error.strerror}") from None
+    print(f"wrote {rows} rows to {out}", file=sys.stderr)
+    return 0

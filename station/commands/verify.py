@@ -1,0 +1,30 @@
+"""``station verify FILE``: check a session file's hash chain and events, read-only."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Register ``station verify``."""
+    parser = subparsers.add_parser(
+        "verify",
+        help="check that a session file is intact (hash chain, events)",
+        description=(
+            "Check a session file without changing it: every line's hash, the chain of 'prev' "
+            "hashes, the order of events. Prints one line with the last line's hash (quote it "
+            "in a report to anchor the file). Exit 0 when intact, 1 naming the first bad line, "
+            "2 when the file is missing or unreadable."
+        ),
+    )
+    parser.add_argument("file", metavar="FILE", help="the session file (.jsonl)")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print the verdict; 0 intact, 1 damaged (StationError gives 2 for a missing file)."""
+    from station.session.verify import verify_session
+
+    result = verify_session(args.file)
+    print(result.message)
+    return 0 if result.ok else 1

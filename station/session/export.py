@@ -1,0 +1,60 @@
+"""Export a session as tidy CSV: one row per cycle and channel, rejected cycles marked."""
+
+from __future__ import annotations
+
+import csv
+from typing import TextIO
+
+from station.session.model import Session
+
+CSV_COLUMNS: tuple[str, ...] = (
+    "cycle",
+    "channel",
+    "value",
+    "unit",
+    "status",
+    "time",
+    "raw_value",
+    "zero",
+    "placement",
+)
+"""The first six are the tidy core; raw value, zero offset and placement follow."""
+
+
+def _number(value: float | None) -> str:
+    # repr keeps every digit the session holds (no rounding on the way out).
+    return "" if value is None else repr(float(value))
+
+
+def export_csv(session: Session, out: TextIO) -> int:
+    """Write the session's cycles to ``out`` as CSV (header row first); return the data rows.
+
+    ``status`` is ``ok`` or ``rejected: <reason>`` (readings are never deleted, so rejected
+    cycles stay in the export, marked); ``time`` is the event's ISO-8601 UTC time.
+    """
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(CSV_COLUMNS)
+    rows = 0
+    for number in sorted(session.cycles):
+        cycle = session.cycles[number]
+        reason = session.rejected.get(number)
+        status = "ok" if reason is None else f"rejected: {reason}"
+        for channel in (*session.channels, *sorted(set(cycle.readings) - set(session.channels))):
+            reading = cycle.readings.get(channel)
+            if reading is None:
+                continue
+            writer.writerow(
+                (
+                    number,
+                    channel,
+                    _number(reading.value),
+                    reading.unit,
+                    status,
+                    cycle.t,
+                    _number(reading.raw_value),
+                    _number(reading.zero),
+                    "" if cycle.placement is None else cycle.placement,
+                )
+            )
+            rows += 1
+    return rows

@@ -1,0 +1,104 @@
+"""The sessions folder: where session files live, and what is in it."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from station.errors import StationError
+from station.session.model import Status, load_session
+
+SESSIONS_ENV = "STATION_SESSIONS"
+
+
+def sessions_folder(
+    explicit: str | os.PathLike[str] | None = None,
+    *,
+    environ: Mapping[str, str] | None = None,
+    cwd: Path | None = None,
+) -> tuple[Path, str]:
+    """The sessions folder and a phrase saying why it is that one (for the screen and commands).
+
+    In order: ``explicit`` (``--sessions DIR``), ``STATION_SESSIONS``, ``./sessions`` when the
+    working directory has one, else ``$XDG_DATA_HOME/station/sessions`` (by default
+    ``~/.local/share/station/sessions``). The folder is not created here; the writer creates it.
+    """
+    environ = os.environ if environ is None else environ
+    if explicit:
+        return Path(explicit), "from --sessions"
+    if environ.get(SESSIONS_ENV):
+        return Path(environ[SESSIONS_ENV]), f"from {SESSIONS_ENV}"
+    local = (cwd or Path.cwd()) / "sessions"
+    if local.is_dir():
+        return local, "the working directory's sessions folder"
+    data_home = environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share")
+    return Path(data_home) / "station" / "sessions", "the user's data folder"
+
+
+@dataclass(frozen=True)
+class SessionSummary:
+    """One line of a sessions listing. ``error`` is set (and the rest mostly empty) for a file
+    that does not load."""
+
+    path: Path
+    robot: str = ""
+    procedure: str = ""
+    created: str = ""
+    status: Status | None = None
+    cycles: int = 0
+    """Accepted (not rejected) cycles."""
+    rejected: int = 0
+    cycles_target: int | None = None
+    operator: str = ""
+    last_hash: str = ""
+    torn: bool = False
+    error: str | None = None
+
+    @property
+    def resumable(self) -> bool:
+        """True for an intact session that has not finished."""
+        return self.error is None and self.status in ("running", "interrupted")
+
+
+def summarise(path: Path) -> SessionSummary:
+    """A summary of one session file, read-only; a file that does not load gives its error."""
+    try:
+        session = load_session(path, recover=False)
+    except StationError as error:
+        return SessionSummary(path=path, error=error.message)
+    return SessionSummary(
+        path=path,
+        robot=session.robot,
+        procedure=session.procedure_id,
+        created=session.created,
+        status=session.status,
+        cycles=len(session.accepted_cycles),
+        rejected=len(session.rejected),
+        cycles_target=session.cycles_target,
+        operator=session.operator,
+        last_hash=session.last_hash,
+        torn=session.torn is not None,
+    )
+
+
+def list_sessions(folder: str | os.PathLike[str]) -> list[SessionSummary]:
+    """Every ``*.jsonl`` in ``folder``, sorted by robot then creation time; [] when no folder.
+
+    Files that do not load are listed with their error (sorted last), never raised.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    summaries = [summarise(path) for path in folder.glob("*.jsonl") if path.is_file()]
+    return sorted(
+        summaries,
+        key=lambda s: (s.error is not None, s.robot.casefold(), s.created, s.path.name),
+    )
+
+
+def find_unfinished(folder: str | os.PathLike[str]) -> list[SessionSummary]:
+    """The sessions that can be resumed (running or interrupted), newest first."""
+    unfinished = [s for s in list_sessions(folder) if s.resumable]
+    return sorted(unfinished, key=lambda s: s.created, reverse=True)

@@ -1,0 +1,72 @@
+"""The sessions folder, the listing and the CSV export."""
+
+from __future__ import annotations
+
+import csv
+import io
+from pathlib import Path
+
+from station.session.export import CSV_COLUMNS, export_csv
+from station.session.model import load_session
+from station.session.store import find_unfinished, list_sessions, sessions_folder
+
+from .conftest import reading_fields, write_session
+
+
+def test_sessions_folder_precedence(tmp_path: Path) -> None:
+    cwd = tmp_path / "work"
+    cwd.mkdir()
+    env = {"STATION_SESSIONS": "/srv/s", "XDG_DATA_HOME": str(tmp_path / "xdg")}
+    assert sessions_folder("/x", environ=env, cwd=cwd) == (Path("/x"), "from --sessions")
+    assert sessions_folder(None, environ=env, cwd=cwd) == (
+        Path("/srv/s"),
+        "from STATION_SESSIONS",
+    )
+    env.pop("STATION_SESSIONS")
+    folder, why = sessions_folder(None, environ=env, cwd=cwd)
+    assert folder == tmp_path / "xdg" / "station" / "sessions" and why == "the user's data folder"
+    (cwd / "sessions").mkdir()
+    assert sessions_folder(None, environ=env, cwd=cwd)[0] == cwd / "sessions"
+    folder, _ = sessions_folder(None, environ={}, cwd=tmp_path)
+    assert folder == Path.home() / ".local" / "share" / "station" / "sessions"
+
+
+def test_listing_sorts_by_robot_and_date_and_keeps_broken_files(tmp_path: Path) -> None:
+    folder = tmp_path / "sessions"
+    write_session(folder, robot="zeta", finish=True)
+    unfinished = write_session(folder, robot="alpha", finish=False)
+    (folder / "broken.jsonl").write_bytes(b"not a session\n")
+    (folder / "notes.txt").write_text("ignored")
+    summaries = list_sessions(folder)
+    assert [s.robot for s in summaries] == ["alpha", "zeta", ""]
+    assert summaries[0].status == "running" and summaries[0].cycles == 4
+    assert summaries[0].rejected == 1 and summaries[0].cycles_target == 30
+    assert summaries[1].status == "finished"
+    assert summaries[2].error is not None and "line 1" in summaries[2].error
+    assert [s.path for s in find_unfinished(folder)] == [unfinished]
+    assert list_sessions(tmp_path / "missing") == []
+
+
+def test_listing_is_read_only_even_with_a_torn_tail(tmp_path: Path) -> None:
+    path = write_session(tmp_path, finish=False)
+    damaged = path.read_bytes() + b'{"seq":'
+    path.write_bytes(damaged)
+    (summary,) = list_sessions(tmp_path)
+    assert summary.torn and summary.resumable
+    assert path.read_bytes() == damaged
+
+
+def test_export_csv_is_tidy_and_marks_rejected_cycles(tmp_path: Path) -> None:
+    session = load_session(write_session(tmp_path, cycles=3))
+    out = io.StringIO()
+    assert export_csv(session, out) == 9
+    rows = list(csv.reader(io.StringIO(out.getvalue())))
+    assert tuple(rows[0]) == CSV_COLUMNS
+    assert rows[0][:6] == ["cycle", "channel", "value", "unit", "status", "time"]
+    expected = reading_fields(2)["channels"]["y"]
+    row = rows[5]
+    assert row[:5] == ["2", "y", repr(expected["value"]), "in", "rejected: bumped the fixture"]
+    assert row[5] == session.cycles[2].t
+    assert row[6:8] == [repr(expected["raw_value"]), "0.375"]
+    assert [r[4] for r in rows[1:4]] == ["ok"] * 3
+    assert [(r[0], r[1]) for r in rows[1:]] == [(str(c), ch) for c in (1, 2, 3) for ch in "xyz"]
