@@ -1,0 +1,413 @@
+"""Run rules on a control chart: the report's four, Western Electric and Nelson.
+
+Every rule looks at the plotted points (individuals or subgroup means) against the centre line
+and the sigma of the plotted statistic, sigma = (UCL - centre) / 3. Comparisons are strict, as
+in qcc: a point exactly on a limit is not beyond it, a point exactly on the centre line is on
+neither side (it breaks a run), and a point exactly at +-1 sigma counts as "within 1 sigma".
+
+qcc semantics (``reference/standards.md`` §2.5, qcc 3.x ``R/rules.R``): a rule flags the point
+that completes its pattern and every later point that keeps the pattern going. "k of m" rules
+look at the window of m points ending at the current point and flag it when at least k of them
+are beyond the zone on one side *and* the current point is one of them.
+
+The report (§2.7.4) lists four signs without defining them further. Our reading:
+
+* report-1, "one point above the UCL or below the LCL": a point beyond the 3-sigma limits.
+* report-2, "seven points in the row going up or down": a trend, seven consecutive points each
+  higher (or each lower) than the one before (six rises or six falls in a row). A flat step
+  breaks it. This is Nelson 3 with seven points instead of six.
+* report-3, "fifteen points in the row going up and down": an oscillation, fifteen consecutive
+  points alternating up, down, up ... (thirteen changes of direction in a row). "Up or down"
+  in rule 2 is a trend, so "up and down" must be the other pattern a chart shows over time;
+  this is Nelson 4 with fifteen points instead of fourteen.
+* report-4, "two points out of three are in zone C": two of three consecutive points beyond
+  2 sigma on the same side (Western Electric 2). The report's "zone C" is read as the outer
+  zone between 2 and 3 sigma: two of three points in the zone nearest the centre line is what
+  a stable process does most of the time, so it cannot be a sign of trouble. The report
+  follows the lettering some SPC software uses, from the centre outward.
+
+Alarms: one :class:`Alarm` per rule per contiguous run of flagged points on the same side;
+``points`` lists every flagged point of that run (1-based), ``text`` is a sentence for the
+technician.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from station.analysis.descriptive import as_readings
+from station.errors import StationError
+
+if TYPE_CHECKING:
+    import numpy as np
+
+RULE_SETS: tuple[str, ...] = ("report", "western-electric", "nelson")
+
+
+@dataclass(frozen=True)
+class Alarm:
+    """One signal: the rule id (``"report-1"``, ``"we-2"``, ``"nelson-7"``), the flagged points
+    (1-based, in order) and a sentence saying what was seen and where to look."""
+
+    rule: str
+    points: tuple[int, ...]
+    text: str
+
+
+# A rule's flags: one boolean array per direction (+1 above/rising, -1 below/falling, 0 none).
+Flags = dict[int, "np.ndarray"]
+
+
+@dataclass(frozen=True)
+class _Context:
+    points: np.ndarray
+    center: float
+    sigma: float
+
+    def beyond(self, multiple: float) -> Flags:
+        line = multiple * self.sigma
+        return {1: self.points > self.center + line, -1: self.points < self.center - line}
+
+
+def _runs(condition: np.ndarray, length: int) -> np.ndarray:
+    """True where ``condition`` has held for at least ``length`` consecutive items up to here."""
+    import numpy as np
+
+    index = np.arange(condition.size)
+    last_break = np.maximum.accumulate(np.where(condition, -1, index))
+    return (index - last_break) >= length
+
+
+def _window_counts(condition: np.ndarray, width: int) -> np.ndarray:
+    """How many of the ``width`` items ending here hold; 0 before a full window exists."""
+    import numpy as np
+
+    totals = np.concatenate(([0], np.cumsum(condition, dtype=np.int64)))
+    counts = np.zeros(condition.size, dtype=np.int64)
+    if condition.size >= width:
+        counts[width - 1 :] = totals[width:] - totals[:-width]
+    return counts
+
+
+def _beyond_limits(ctx: _Context) -> Flags:
+    return ctx.beyond(3.0)
+
+
+def _k_of_m(k: int, m: int, multiple: float) -> Callable[[_Context], Flags]:
+    def rule(ctx: _Context) -> Flags:
+        flags = ctx.beyond(multiple)
+        return {side: cond & (_window_counts(cond, m) >= k) for side, cond in flags.items()}
+
+    return rule
+
+
+def _same_side(length: int) -> Callable[[_Context], Flags]:
+    def rule(ctx: _Context) -> Flags:
+        return {side: _runs(cond, length) for side, cond in ctx.beyond(0.0).items()}
+
+    return rule
+
+
+def _shift_to_points(flags_on_steps: np.ndarray, offset: int, size: int) -> np.ndarray:
+    """Flags indexed by difference (or change of direction) moved onto the point that ends it."""
+    import numpy as np
+
+    shifted = np.zeros(size, dtype=bool)
+    shifted[offset : offset + flags_on_steps.size] = flags_on_steps
+    return shifted
+
+
+def _trend(length: int) -> Callable[[_Context], Flags]:
+    def rule(ctx: _Context) -> Flags:
+        import numpy as np
+
+        steps = np.diff(ctx.points)
+        size = ctx.points.size
+        return {
+            1: _shift_to_points(_runs(steps > 0, length - 1), 1, size),
+            -1: _shift_to_points(_runs(steps < 0, length - 1), 1, size),
+        }
+
+    return rule
+
+
+def _alternating(length: int) -> Callable[[_Context], Flags]:
+    def rule(ctx: _Context) -> Flags:
+        import numpy as np
+
+        directions = np.sign(np.diff(ctx.points))
+        turns = directions[1:] * directions[:-1] < 0
+        return {0: _shift_to_points(_runs(turns, length - 2), 2, ctx.points.size)}
+
+    return rule
+
+
+def _within_one_sigma(length: int) -> Callable[[_Context], Flags]:
+    def rule(ctx: _Context) -> Flags:
+        inside = (ctx.points >= ctx.center - ctx.sigma) & (ctx.points <= ctx.center + ctx.sigma)
+        return {0: _runs(inside, length)}
+
+    return rule
+
+
+def _outside_both_sides(length: int) -> Callable[[_Context], Flags]:
+    def rule(ctx: _Context) -> Flags:
+        side = ctx.beyond(1.0)
+        above, below = side[1], side[-1]
+        full = _window_counts(above | below, length) == length
+        mixed = (_window_counts(above, length) > 0) & (_window_counts(below, length) > 0)
+        return {0: full & mixed}
+
+    return rule
+
+
+Formatter = Callable[[float], str]
+# A pattern phrase for the alarm text: (side, context, number formatter) -> words.
+Pattern = Callable[[int, "_Context", Formatter], str]
+
+
+def _side_word(side: int) -> str:
+    return "above" if side > 0 else "below"
+
+
+@dataclass(frozen=True)
+class _Kind:
+    """One kind of signal, shared by the rule sets that use it (WE 2 is Nelson 5 is report 4)."""
+
+    description: str
+    check: Callable[[_Context], Flags]
+    pattern: Pattern | None  # None: the beyond-the-limits rule, which has its own sentence
+    advice: str = ""
+
+    def text(self, run: list[int], side: int, ctx: _Context, fmt: Formatter) -> str:
+        """The alarm sentence for a run of flagged points on one side."""
+        plural = len(run) > 1
+        if self.pattern is None:
+            limit = ctx.center + 3 * ctx.sigma * side
+            return (
+                f"{_subject(run)} {'are' if plural else 'is'} {_side_word(side)} the "
+                f"{'upper' if side > 0 else 'lower'} control limit ({fmt(limit)}): "
+                f"look for a cause at {'those cycles' if plural else 'that cycle'}."
+            )
+        advice = self.advice.format(direction="up" if side > 0 else "down")
+        verb = "each end" if plural else "completes"
+        return f"{_subject(run)} {verb} {self.pattern(side, ctx, fmt)}: {advice}."
+
+
+def _zone_pattern(k: int, m: int, multiple: int) -> Pattern:
+    def pattern(side: int, ctx: _Context, fmt: Formatter) -> str:
+        line = ctx.center + multiple * ctx.sigma * side
+        where = _side_word(side)
+        return (
+            f"{k} of {m} points beyond {multiple} sigma {where} the centre line "
+            f"({where} {fmt(line)})"
+        )
+
+    return pattern
+
+
+def _side_pattern(length: int) -> Pattern:
+    return lambda side, ctx, fmt: (
+        f"{length} points in a row {_side_word(side)} the centre line ({fmt(ctx.center)})"
+    )
+
+
+def _trend_pattern(length: int) -> Pattern:
+    return lambda side, ctx, fmt: (
+        f"{length} points in a row, each {'higher' if side > 0 else 'lower'} than the one before"
+    )
+
+
+def _fixed_pattern(words: str) -> Pattern:
+    return lambda side, ctx, fmt: words
+
+
+_SHIFT = (
+    "the process may have shifted {direction}; look for a change in set-up, fixture or temperature"
+)
+_DRIFT = (
+    "something is drifting {direction}; look for warm-up, wear, or a fixture or gauge working loose"
+)
+_OSCILLATION = (
+    "look for over-correction or two causes taking turns, such as two fixtures, two approach "
+    "directions or backlash"
+)
+
+_BEYOND_LIMITS = _Kind(
+    "One point beyond the 3-sigma control limits (above the UCL or below the LCL).",
+    _beyond_limits,
+    None,
+)
+_TWO_OF_THREE = _Kind(
+    "Two of three points in a row beyond 2 sigma on the same side of the centre line.",
+    _k_of_m(2, 3, 2.0),
+    _zone_pattern(2, 3, 2),
+    _SHIFT,
+)
+_FOUR_OF_FIVE = _Kind(
+    "Four of five points in a row beyond 1 sigma on the same side of the centre line.",
+    _k_of_m(4, 5, 1.0),
+    _zone_pattern(4, 5, 1),
+    _SHIFT,
+)
+
+
+def _same_side_kind(length: int, words: str) -> _Kind:
+    return _Kind(
+        f"{words} points in a row on the same side of the centre line.",
+        _same_side(length),
+        _side_pattern(length),
+        _SHIFT,
+    )
+
+
+def _trend_kind(length: int, description: str) -> _Kind:
+    return _Kind(description, _trend(length), _trend_pattern(length), _DRIFT)
+
+
+def _oscillation_kind(length: int, description: str) -> _Kind:
+    return _Kind(
+        description,
+        _alternating(length),
+        _fixed_pattern(f"{length} points in a row alternating up and down"),
+        _OSCILLATION,
+    )
+
+
+_RULES: dict[str, tuple[tuple[str, _Kind], ...]] = {
+    "report": (
+        ("report-1", _BEYOND_LIMITS),
+        (
+            "report-2",
+            _trend_kind(7, "Seven points in a row going up or down, each beyond the last."),
+        ),
+        (
+            "report-3",
+            _oscillation_kind(15, "Fifteen points in a row going up and down, alternating."),
+        ),
+        (
+            "report-4",
+            _Kind(
+                "Two of three points in zone C: beyond 2 sigma on the same side of the centre.",
+                _TWO_OF_THREE.check,
+                _TWO_OF_THREE.pattern,
+                _SHIFT,
+            ),
+        ),
+    ),
+    "western-electric": (
+        ("we-1", _BEYOND_LIMITS),
+        ("we-2", _TWO_OF_THREE),
+        ("we-3", _FOUR_OF_FIVE),
+        ("we-4", _same_side_kind(8, "Eight")),
+    ),
+    "nelson": (
+        ("nelson-1", _BEYOND_LIMITS),
+        ("nelson-2", _same_side_kind(9, "Nine")),
+        ("nelson-3", _trend_kind(6, "Six points in a row steadily increasing or decreasing.")),
+        ("nelson-4", _oscillation_kind(14, "Fourteen points in a row alternating up and down.")),
+        ("nelson-5", _TWO_OF_THREE),
+        ("nelson-6", _FOUR_OF_FIVE),
+        (
+            "nelson-7",
+            _Kind(
+                "Fifteen points in a row within 1 sigma of the centre line (either side).",
+                _within_one_sigma(15),
+                _fixed_pattern("15 points in a row within 1 sigma of the centre line"),
+                "the spread is smaller than the limits assume; check that the limits are "
+                "current and that readings from different set-ups are not averaged together",
+            ),
+        ),
+        (
+            "nelson-8",
+            _Kind(
+                "Eight points in a row beyond 1 sigma, on both sides, none within 1 sigma.",
+                _outside_both_sides(8),
+                _fixed_pattern(
+                    "8 points in a row beyond 1 sigma on both sides, none near the centre line"
+                ),
+                "look for two sources taking turns, such as two fixtures or two approach "
+                "directions",
+            ),
+        ),
+    ),
+}
+
+
+def _rules_of(rule_set: str) -> tuple[tuple[str, _Kind], ...]:
+    try:
+        return _RULES[rule_set]
+    except (KeyError, TypeError):
+        known = ", ".join(RULE_SETS)
+        raise StationError(f"unknown rule set {rule_set!r}: use one of {known}") from None
+
+
+def rule_descriptions(rule_set: str) -> list[tuple[str, str]]:
+    """(rule id, one-line description) of every rule in the set, for help screens and reports."""
+    return [(rule_id, kind.description) for rule_id, kind in _rules_of(rule_set)]
+
+
+def _formatter(sigma: float, unit: str | None) -> Formatter:
+    """Numbers to one decimal beyond the sigma's first significant digit, with the unit."""
+    decimals = 4 if sigma <= 0 else max(0, min(12, 1 - math.floor(math.log10(sigma))))
+    suffix = f" {unit}" if unit else ""
+    return lambda value: f"{value:.{decimals}f}{suffix}"
+
+
+def _subject(points: list[int]) -> str:
+    if len(points) == 1:
+        return f"Point {points[0]}"
+    if len(points) == 2:
+        return f"Points {points[0]} and {points[1]}"
+    return f"Points {points[0]} to {points[-1]}"
+
+
+def _contiguous(indices: np.ndarray) -> list[list[int]]:
+    """Split sorted 0-based indices into runs of consecutive ones, as 1-based point numbers."""
+    groups: list[list[int]] = []
+    for index in indices.tolist():
+        if groups and groups[-1][-1] == index:  # previous 1-based number == this 0-based index
+            groups[-1].append(index + 1)
+        else:
+            groups.append([index + 1])
+    return groups
+
+
+def check_rules(
+    points: Iterable[float] | np.ndarray,
+    center: float | None,
+    sigma: float | None,
+    rule_set: str = "report",
+    *,
+    unit: str | None = None,
+) -> list[Alarm]:
+    """Every alarm of the rule set on the plotted points, ordered by first point then rule.
+
+    ``sigma`` is the sigma of the plotted statistic, (UCL - centre) / 3 (see
+    ``ControlChart.point_sigma``). With no centre or sigma (a chart without limits) there is
+    nothing to check and the list is empty. ``unit`` is appended to the values in the text.
+    """
+    rules = _rules_of(rule_set)
+    values = as_readings(points, what="point")
+    if center is None or sigma is None or values.size == 0:
+        return []
+    if not (math.isfinite(center) and math.isfinite(sigma)) or sigma < 0:
+        raise StationError(
+            f"control limits with centre {center} and sigma {sigma} cannot be checked: "
+            "sigma must be a finite number >= 0"
+        )
+    import numpy as np
+
+    ctx = _Context(values, float(center), float(sigma))
+    fmt = _formatter(float(sigma), unit)
+    found: list[tuple[int, int, Alarm]] = []
+    for order, (rule_id, kind) in enumerate(rules):
+        for side, flags in kind.check(ctx).items():
+            for run in _contiguous(np.flatnonzero(flags)):
+                text = kind.text(run, side, ctx, fmt)
+                found.append((run[0], order, Alarm(rule_id, tuple(run), text)))
+    found.sort(key=lambda item: (item[0], item[1]))
+    return [alarm for _, _, alarm in found]
