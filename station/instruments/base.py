@@ -96,13 +96,16 @@ class Protocol:
 
     name: ClassVar[str]
     description: ClassVar[str]
-    polled: ClassVar[bool]
-    """True when the device answers a request; False when it pushes frames by itself."""
 
     settings: SerialSettings = field(default_factory=SerialSettings)
     terminator: bytes = b"\r"
     channels: tuple[str, ...] = ("1",)
     """Device channels this port serves, in the order they are polled."""
+
+    @property
+    def polled(self) -> bool:
+        """True when the device answers a request; False when it pushes frames by itself."""
+        raise NotImplementedError
 
     def parse(self, frame: bytes) -> Value | Rejected:
         """Turn one frame (terminator stripped) into a value or a named rejection. Never raises."""
