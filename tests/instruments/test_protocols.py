@@ -404,3 +404,9 @@ def test_channels_a_device_cannot_address_are_refused(name, channels, words):
     assert words in error.value.message
     with pytest.raises(ValueError):
         get_protocol(name).encode(channels.split(",")[-1], 0.1, 0.001, "mm")
+
+
+def test_digimatic_values_are_the_exact_decimal_on_the_display():
+    protocol = get_protocol("digimatic")
+    assert protocol.parse(b"FFFF801248230").value == -12.482
+    assert protocol.parse(b"FFFF000000150").value == 0.00001

@@ -27,7 +27,8 @@ _UNIT_CODES = {
 """d13 character -> unit: 0 mm, 1 in, 2-4 mm (LSM-6200), 5-7 in (LSM-6200), 8 in (Mahr)."""
 
 _SIGNS = {ord("0"): 1.0, ord("8"): -1.0}
-_SCALE = tuple(10.0**-n for n in range(6))
+# Divide by an exact power of ten: 1248 * 10.0**-2 is 12.480000000000001, 1248 / 100 is 12.48.
+_DIVISOR = tuple(10**n for n in range(6))
 _FRAME_LENGTH = 13
 
 
@@ -60,7 +61,7 @@ class DigimaticText(GaugeProtocol):
         unit = _UNIT_CODES.get(frame[12])
         if unit is None:
             return Rejected("malformed", "the Digimatic unit digit must be 0 to 8")
-        return self.accept(self.channels[0], sign * int(digits) * _SCALE[point], unit)
+        return self.accept(self.channels[0], sign * int(digits) / _DIVISOR[point], unit)
 
     def encode(self, device_channel: str, value: float, resolution: float, unit: str) -> bytes:
         """``FFFF{sign}{6 BCD digits}{point}{unit}`` and the terminator."""

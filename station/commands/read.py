@@ -1,0 +1,254 @@
+"""``station read``: a miniterm for gauges: readings as they arrive, and every rejected frame."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import queue
+import sys
+import threading
+import time
+
+from station.errors import StationError
+
+DESCRIPTION = """\
+Open a gauge port and print each reading as it arrives (station channel, value, unit and the
+raw frame) and one line per rejected frame (error, status, malformed, out of range). A polled
+protocol is polled continuously (--interval); a push protocol waits for the device (DATA
+button, foot switch, data logger); --trigger stable prints a set once every channel has stayed
+within 2 x resolution for 0.5 s. Connection changes go to stderr; the reader reconnects by
+itself after an unplug. Ctrl-C stops.
+
+--jsonl prints one JSON object per line instead: {"channel", "value", "unit", "raw"} for a
+reading, {"rejected", "raw"} for a rejected frame (rejected = the reason).
+
+exit codes: 0 done (or --count reached); 2 bad port, protocol or option; 130 interrupted.
+"""
+
+
+POLL_PATIENCE = 1.0
+"""Seconds a poll waits for its answers before the next poll is sent anyway."""
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Register ``station read``."""
+    from station.instruments.protocols import protocol_names
+
+    parser = subparsers.add_parser(
+        "read",
+        help="print readings and rejected frames from a gauge port",
+        description=DESCRIPTION,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--port",
+        required=True,
+        metavar="URL",
+        help="device path, /dev/serial/by-id/..., rfc2217://HOST:PORT, socket://HOST:PORT "
+        "or hwgrep://VID:PID",
+    )
+    parser.add_argument(
+        "--protocol",
+        required=True,
+        metavar="NAME",
+        help="gauge protocol: " + ", ".join(protocol_names()),
+    )
+    parser.add_argument(
+        "--map",
+        metavar="DEV=CH,...",
+        help="device channel to station channel, e.g. 1=x,2=y,3=z (the device channels "
+        "polled are the map's)",
+    )
+    parser.add_argument(
+        "--trigger",
+        choices=("poll", "push", "stable"),
+        help="poll (default for a polled protocol), push (default otherwise) or stable",
+    )
+    parser.add_argument("--count", metavar="N", help="stop after N readings")
+    parser.add_argument("--jsonl", action="store_true", help="one JSON object per line")
+    parser.add_argument("--baud", metavar="BAUD", help="baud rate (default: the protocol's)")
+    parser.add_argument("--bytesize", metavar="BITS", help="data bits, 5..8")
+    parser.add_argument("--parity", metavar="P", help="parity N, E, O, M or S")
+    parser.add_argument("--stopbits", metavar="S", help="stop bits 1, 1.5 or 2")
+    parser.add_argument("--unit", default="mm", help="unit when frames carry none (mm)")
+    parser.add_argument(
+        "--interval",
+        default="0.2",
+        metavar="S",
+        help="seconds between polls of a polled device (default 0.2)",
+    )
+    parser.add_argument(
+        "--resolution",
+        default="0.001",
+        metavar="R",
+        help="gauge resolution, for --trigger stable (default 0.001)",
+    )
+    parser.set_defaults(func=run)
+
+
+def parse_map(text: str | None) -> dict[str, str]:
+    """``"1=x,2=y"`` -> ``{"1": "x", "2": "y"}``; StationError on a malformed pair."""
+    if not text:
+        return {}
+    mapping: dict[str, str] = {}
+    for pair in text.split(","):
+        device, sep, station = (part.strip() for part in pair.partition("="))
+        if not sep or not device or not station:
+            raise StationError(
+                f"--map {text!r}: write device=station pairs separated by commas, e.g. 1=x,2=y,3=z."
+            )
+        if device in mapping:
+            raise StationError(f"--map {text!r} names device channel {device} twice.")
+        mapping[device] = station
+    if len(set(mapping.values())) != len(mapping):
+        raise StationError(f"--map {text!r} maps two device channels to one station channel.")
+    return mapping
+
+
+def positive_number(text: str | None, name: str, kind: type = float) -> float | int | None:
+    """``text`` as a positive number (None stays None); StationError otherwise."""
+    if text is None:
+        return None
+    try:
+        value = kind(text)
+    except ValueError:
+        raise StationError(f"{name} {text!r} is not a number.") from None
+    if not value > 0:
+        raise StationError(f"{name} must be more than 0, not {text}.")
+    return value
+
+
+def _print_item(item: object, jsonl: bool) -> bool:
+    """Print a reading or a rejection; True when it was a reading."""
+    from station.instruments.base import Reading
+
+    if isinstance(item, Reading):
+        if jsonl:
+            line = json.dumps(
+                {"channel": item.channel, "value": item.value, "unit": item.unit, "raw": item.raw}
+            )
+        else:
+            line = f"{item.channel:>4}  {item.value:+.6g} {item.unit}  {item.raw}"
+        print(line, flush=True)
+        return True
+    if jsonl:
+        line = json.dumps({"rejected": item.reason, "raw": item.raw})
+    else:
+        line = f"rejected ({item.reason}): {item.detail}  [{item.raw}]"
+    print(line, flush=True)
+    return False
+
+
+def run(args: argparse.Namespace) -> int:
+    """Read until --count readings arrived or Ctrl-C."""
+    from station.instruments.gauge import GaugeReader, GaugeSet, PortSpec
+    from station.instruments.protocols import get_protocol
+
+    count = positive_number(args.count, "--count", int)
+    interval = positive_number(args.interval, "--interval")
+    resolution = positive_number(args.resolution, "--resolution")
+    channel_map = parse_map(args.map)
+    protocol = get_protocol(
+        args.protocol,
+        baudrate=args.baud,
+        bytesize=args.bytesize,
+        parity=args.parity,
+        stopbits=args.stopbits,
+        channels=tuple(channel_map) or None,
+    )
+    trigger = args.trigger or ("poll" if protocol.polled else "push")
+    if trigger == "poll" and not protocol.polled:
+        raise StationError(
+            f"The {protocol.name} protocol has no request to poll with: use --trigger push."
+        )
+    events: queue.Queue = queue.Queue(maxsize=10_000)
+
+    opened = threading.Event()
+
+    def on_status(status) -> None:
+        # The first failed open is the command's own error (exit 2), not a status line.
+        if status.state == "connected":
+            opened.set()
+        if not opened.is_set():
+            return
+        if status.state in ("disconnected", "connected") or "failed" in status.message:
+            print(f"station: {status.state}: {status.message}", file=sys.stderr, flush=True)
+
+    gauges = None
+    if trigger == "stable":
+        gauges = GaugeSet(
+            [PortSpec(args.port, protocol, channel_map)],
+            trigger="stable",
+            unit=args.unit,
+            resolution=resolution,
+            poll_interval=interval,
+            on_rejection=events.put_nowait,
+            on_status=on_status,
+        )
+        reader = gauges.readers[0]
+    else:
+        reader = GaugeReader(
+            args.port, protocol, channel_map, unit=args.unit, events=events, on_status=on_status
+        )
+    reader.start()
+    try:
+        _wait_first_open(reader)
+        if not args.jsonl:
+            print(
+                f"station: reading {args.port} ({protocol.name}, {reader.settings.describe()}, "
+                f"trigger {trigger}); Ctrl-C stops",
+                file=sys.stderr,
+                flush=True,
+            )
+        return _loop(reader, gauges, events, trigger, count, interval, args.jsonl)
+    except KeyboardInterrupt:
+        return 130
+    finally:
+        if gauges is not None:
+            gauges.stop()
+        else:
+            reader.stop()
+
+
+def _wait_first_open(reader) -> None:
+    """Fail at once (exit 2) when the port cannot be opened the first time."""
+    deadline = time.monotonic() + 15.0
+    while reader.state in ("stopped", "connecting") and time.monotonic() < deadline:
+        time.sleep(0.01)
+    if reader.state != "connected":
+        message = reader.last_message or f"Could not open {reader.url}."
+        raise StationError(message)
+
+
+def _loop(reader, gauges, events, trigger, count, interval, jsonl) -> int:
+    readings = 0
+    # A poll waits for its answers (or POLL_PATIENCE) before the next one: a new poll flushes
+    # the input, so polling faster than the device answers would starve the reader.
+    expected = max(1, len(reader.device_channels))
+    answered = expected
+    polled_at = -1e9
+    while count is None or readings < count:
+        if gauges is not None:
+            result = gauges.capture(timeout=max(2.0, 4 * interval))
+            while not events.empty():
+                _print_item(events.get_nowait(), jsonl)
+            for channel in result.channels:
+                if channel in result.readings and (count is None or readings < count):
+                    readings += _print_item(result.readings[channel], jsonl)
+            continue
+        now = time.monotonic()
+        if (
+            trigger == "poll"
+            and now - polled_at >= interval
+            and (answered >= expected or now - polled_at >= POLL_PATIENCE)
+        ):
+            reader.trigger(True)
+            polled_at, answered = now, 0
+        try:
+            item = events.get(timeout=0.02)
+        except queue.Empty:
+            continue
+        is_reading = _print_item(item, jsonl)
+        readings += is_reading
+        answered += 1  # a rejected frame is an answer too
+    return 0

@@ -1,0 +1,187 @@
+"""``station simulate``: a virtual robot in a fixture, speaking a gauge protocol on a pty or TCP."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import threading
+
+from station.commands.read import positive_number
+from station.errors import StationError
+
+DESCRIPTION = """\
+Run a simulated fixture with one dial indicator per channel, speaking a gauge protocol, so that
+`station read`, `station capture` and the TUI work with no hardware. The first line on stdout
+is the URL to open (a pseudo-terminal path, or socket://127.0.0.1:PORT with --tcp); it then
+runs until Ctrl-C or SIGTERM. Seeded: the k-th reading of a channel depends only on --seed and
+k. With --disconnect-every on a pty the URL is a symlink that follows the pty across
+disconnects.
+
+Model options take one value for every channel or CH=V pairs, e.g. --bias x=0.002,y=-0.001.
+Fault rates are probabilities per frame sent.
+"""
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Register ``station simulate``."""
+    from station.instruments.protocols import protocol_names
+
+    parser = subparsers.add_parser(
+        "simulate",
+        help="a simulated robot and gauges on a pseudo-terminal or a TCP port",
+        description=DESCRIPTION,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--protocol",
+        required=True,
+        metavar="NAME",
+        help="gauge protocol: " + ", ".join(protocol_names()),
+    )
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--pty", action="store_true", help="serve on a pseudo-terminal (default)")
+    where.add_argument("--tcp", metavar="PORT", help="serve on TCP 127.0.0.1:PORT (0 = free)")
+    parser.add_argument("--link", metavar="PATH", help="pty: also make PATH a symlink to it")
+    parser.add_argument("--channels", default="x,y,z", help="station channels (default x,y,z)")
+    parser.add_argument("--seed", default="0", help="random seed (default 0)")
+    model = parser.add_argument_group("model (one value, or CH=V,... per channel)")
+    for flag, default, text in (
+        ("--bias", "0", "offset from nominal"),
+        ("--noise", "0.0005", "noise sigma"),
+        ("--skew", "0", "skew-normal shape alpha (0 = normal)"),
+        ("--drift", "0", "warm-up drift approached exponentially"),
+        ("--drift-tau", "10", "warm-up time constant, in readings"),
+        ("--backlash", "0", "difference between the two approach directions"),
+        ("--outlier-rate", "0", "probability of an outlier per reading"),
+    ):
+        model.add_argument(flag, default=default, metavar="V", help=f"{text} (default {default})")
+    gauge = parser.add_argument_group("gauge")
+    gauge.add_argument("--resolution", default="0.001", help="gauge resolution (0.001)")
+    gauge.add_argument("--unit", default="mm", choices=("mm", "in"), help="unit (mm)")
+    gauge.add_argument("--range", default="-12.5,12.5", metavar="LOW,HIGH", help="gauge range")
+    line = parser.add_argument_group("line and faults")
+    line.add_argument(
+        "--push-rate",
+        metavar="HZ",
+        help="sets pushed per second (default 1 for a push protocol, 0 = answer polls only)",
+    )
+    for flag, text in (
+        ("--garbage-rate", "a line of noise bytes before a frame"),
+        ("--torn-rate", "a frame written in two pieces"),
+        ("--error-rate", "an error/status frame instead of a reading"),
+        ("--silence-rate", "no answer to a request"),
+        ("--stale-rate", "old frames delivered again after a frame"),
+    ):
+        line.add_argument(flag, default="0", metavar="P", help=f"{text} (probability)")
+    line.add_argument("--disconnect-every", default="0", metavar="S", help="seconds (0 = never)")
+    line.add_argument("--down-time", default="1", metavar="S", help="seconds a disconnect lasts")
+    parser.set_defaults(func=run)
+
+
+def per_channel(text: str, name: str, channels: list[str]) -> dict[str, float]:
+    """``"0.1"`` or ``"x=0.1,y=0.2"`` -> a value per channel (0 where a pair is absent)."""
+    try:
+        if "=" not in text:
+            return dict.fromkeys(channels, float(text))
+        values = dict.fromkeys(channels, 0.0)
+        for pair in text.split(","):
+            channel, _, value = (part.strip() for part in pair.partition("="))
+            if channel not in values:
+                raise StationError(
+                    f"{name} names channel {channel!r}; the channels are {', '.join(channels)}."
+                )
+            values[channel] = float(value)
+        return values
+    except ValueError:
+        raise StationError(f"{name} {text!r}: give a number or CH=NUMBER pairs.") from None
+
+
+def _float(text: str, name: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise StationError(f"{name} {text!r} is not a number.") from None
+
+
+def build_simulator(args: argparse.Namespace):
+    """The :class:`~station.instruments.simulator.Simulator` the options describe."""
+    from station.instruments.protocols import get_protocol
+    from station.instruments.simulator import AxisModel, Faults, FixtureModel, GaugeSpec, Simulator
+
+    channels = [c.strip() for c in args.channels.split(",") if c.strip()]
+    if not channels or len(set(channels)) != len(channels):
+        raise StationError(f"--channels {args.channels!r}: name each channel once, e.g. x,y,z.")
+    fields = {
+        "bias": per_channel(args.bias, "--bias", channels),
+        "noise": per_channel(args.noise, "--noise", channels),
+        "skew": per_channel(args.skew, "--skew", channels),
+        "drift": per_channel(args.drift, "--drift", channels),
+        "drift_tau": per_channel(args.drift_tau, "--drift-tau", channels),
+        "backlash": per_channel(args.backlash, "--backlash", channels),
+        "outlier_rate": per_channel(args.outlier_rate, "--outlier-rate", channels),
+    }
+    axes = {c: AxisModel(**{key: values[c] for key, values in fields.items()}) for c in channels}
+    try:
+        low, high = (float(v) for v in args.range.split(","))
+    except ValueError:
+        raise StationError(f"--range {args.range!r}: give LOW,HIGH, e.g. -12.5,12.5.") from None
+    resolution = positive_number(args.resolution, "--resolution")
+    model = FixtureModel(axes, GaugeSpec(resolution, low, high, args.unit))
+    faults = Faults(
+        garbage_rate=_float(args.garbage_rate, "--garbage-rate"),
+        torn_rate=_float(args.torn_rate, "--torn-rate"),
+        error_rate=_float(args.error_rate, "--error-rate"),
+        silence_rate=_float(args.silence_rate, "--silence-rate"),
+        stale_rate=_float(args.stale_rate, "--stale-rate"),
+        disconnect_every=_float(args.disconnect_every, "--disconnect-every"),
+        down_time=_float(args.down_time, "--down-time"),
+    )
+    protocol = get_protocol(args.protocol)
+    if args.push_rate is None:
+        push_rate = 0.0 if protocol.polled else 1.0
+    else:
+        push_rate = _float(args.push_rate, "--push-rate")
+    try:
+        seed = int(args.seed)
+    except ValueError:
+        raise StationError(f"--seed {args.seed!r} is not a whole number.") from None
+    return Simulator(protocol, model, faults, seed, push_rate=push_rate)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print the URL, serve until SIGINT/SIGTERM."""
+    simulator = build_simulator(args)
+    done = threading.Event()
+    previous = signal.signal(signal.SIGTERM, lambda *_: done.set())
+    try:
+        if args.tcp is not None:
+            try:
+                port = int(args.tcp)
+            except ValueError:
+                raise StationError(f"--tcp {args.tcp!r} is not a port number.") from None
+            try:
+                url = simulator.start_tcp(port)
+            except OSError as error:
+                raise StationError(
+                    f"Cannot serve on 127.0.0.1:{port} ({error.strerror or error}): "
+                    "choose another port, or 0 for a free one."
+                ) from None
+        else:
+            url = simulator.start_pty(link=args.link)
+        print(url, flush=True)
+        print(
+            f"station: simulating {', '.join(simulator.model.channels)} "
+            f"({simulator.protocol.name}) on {url}; Ctrl-C stops",
+            file=sys.stderr,
+            flush=True,
+        )
+        try:
+            while not done.wait(0.2):
+                pass
+        except KeyboardInterrupt:
+            pass
+        return 0
+    finally:
+        simulator.stop()
+        signal.signal(signal.SIGTERM, previous)

@@ -1,0 +1,785 @@
+"""A virtual robot with its end effector in a fixture, speaking a gauge protocol on a pty or TCP.
+
+Two halves, so later procedures add models without touching the server:
+
+* A **model** (:class:`RobotModel`) is a pure function ``value(channel, k, seed)``: what the
+  gauge on ``channel`` shows for its ``k``-th reading. :class:`FixtureModel` is the repeatability
+  set-up (per-axis bias, noise, skew, warm-up drift, backlash, outliers; a gauge with a
+  resolution and a range). An accuracy model (two fixtures, a pendant display) or a linearity
+  model (a bar with straightness error and sag, a linear scale, strokes) is another subclass with
+  its own state (placement, stroke position); the server only calls ``value``.
+* The **server** (:class:`Simulator`) owns a pseudo-terminal master or a TCP port bound to
+  127.0.0.1, answers the protocol's requests (or pushes sets at a rate, or on demand for
+  tests) with ``protocol.encode`` frames, and injects faults with seeded rates (:class:`Faults`).
+
+Determinism: the k-th reading of a channel depends only on the seed and k (each value draws from
+its own generator seeded with ``(seed, channel index, k)``); fault decisions come from one
+generator seeded with the seed, in the order frames are sent.
+
+Disconnect and return on a pty: closing the master makes the reader see EIO /
+``SerialException`` at once, but the kernel then removes ``/dev/pts/N``, and the next pty may get
+another number. So a pty simulator that will disconnect hands out a *symlink* (in a private
+temporary folder, or a path you choose) and re-points it at the new pty when it comes back, the
+way ``socat``'s ``link=`` does; the reader reopens the same URL. Over TCP the listener is closed
+too (a device-server restart: the reader sees "refused") and bound again on the same port.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import random
+import select
+import shutil
+import socket
+import tempfile
+import threading
+import time
+import tty
+from collections import deque
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from station.errors import StationError
+from station.instruments.base import Protocol
+
+# Garbage is drawn from bytes no protocol reads as a value (no digits, signs, points or letters
+# that start a frame), so a garbage line is always a rejection, never a reading.
+_GARBAGE_BYTES = bytes(range(0x80, 0x100)) + b"!#$%&*@^_`|~"
+
+
+@dataclass(frozen=True)
+class AxisModel:
+    """What one axis of the robot does at one gauge, in the gauge's unit.
+
+    ``skew`` is the shape α of a skew-normal error (0 = normal; the noise keeps σ = ``noise``).
+    ``drift`` is the warm-up offset approached exponentially with a time constant of
+    ``drift_tau`` readings. ``backlash`` is the full difference between approaching from the
+    two directions (each reading's direction is drawn at random). An outlier (probability
+    ``outlier_rate``) adds ± ``outlier_size`` × ``noise``.
+    """
+
+    bias: float = 0.0
+    noise: float = 0.0005
+    skew: float = 0.0
+    drift: float = 0.0
+    drift_tau: float = 10.0
+    backlash: float = 0.0
+    outlier_rate: float = 0.0
+    outlier_size: float = 8.0
+
+
+@dataclass(frozen=True)
+class GaugeSpec:
+    """The indicator: what it can show. Values are quantised and clipped to the range."""
+
+    resolution: float = 0.001
+    low: float = -12.5
+    high: float = 12.5
+    unit: str = "mm"
+
+    def show(self, value: float) -> float:
+        """``value`` as the gauge displays it: clipped to its range, at its resolution."""
+        clipped = min(self.high, max(self.low, value))
+        steps = round(clipped / self.resolution)
+        decimals = max(0, -math.floor(math.log10(self.resolution)) + 1)
+        return round(steps * self.resolution, decimals)
+
+
+class RobotModel:
+    """The interface the server needs: channels, a gauge per channel, and the k-th value."""
+
+    channels: tuple[str, ...] = ()
+
+    def gauge(self, channel: str) -> GaugeSpec:
+        """The indicator on ``channel``."""
+        raise NotImplementedError
+
+    def value(self, channel: str, k: int, seed: int) -> float:
+        """What ``channel``'s gauge shows for its ``k``-th reading (0-based), for ``seed``."""
+        raise NotImplementedError
+
+
+def _skew_normal_unit(alpha: float, z0: float, z1: float) -> float:
+    """A skew-normal draw with shape ``alpha``, standardised to mean 0 and σ 1."""
+    if alpha == 0:
+        return z1
+    delta = alpha / math.sqrt(1 + alpha * alpha)
+    x = delta * abs(z0) + math.sqrt(1 - delta * delta) * z1
+    mean = delta * math.sqrt(2 / math.pi)
+    sd = math.sqrt(1 - 2 * delta * delta / math.pi)
+    return (x - mean) / sd
+
+
+class FixtureModel(RobotModel):
+    """The repeatability set-up: the end effector returns to one fixture; a gauge per axis."""
+
+    def __init__(
+        self,
+        axes: Mapping[str, AxisModel],
+        gauge: GaugeSpec | Mapping[str, GaugeSpec] = GaugeSpec(),
+    ) -> None:
+        if not axes:
+            raise StationError("A simulated fixture needs at least one channel, e.g. x.")
+        self.axes = dict(axes)
+        self.channels = tuple(self.axes)
+        self._gauges = (
+            {c: gauge.get(c, GaugeSpec()) for c in self.channels}
+            if isinstance(gauge, Mapping)
+            else dict.fromkeys(self.channels, gauge)
+        )
+
+    def gauge(self, channel: str) -> GaugeSpec:
+        """The indicator on ``channel``."""
+        return self._gauges[channel]
+
+    def true_value(self, channel: str, k: int, seed: int) -> float:
+        """The indicator's reading before quantisation and clipping."""
+        axis = self.axes[channel]
+        index = self.channels.index(channel)
+        # One generator per (seed, channel, k): the k-th value never depends on other draws.
+        rng = random.Random(f"{seed}/{index}/{k}")
+        z0, z1 = rng.gauss(0.0, 1.0), rng.gauss(0.0, 1.0)
+        direction = 1.0 if rng.random() < 0.5 else -1.0
+        outlier = rng.random() < axis.outlier_rate
+        outlier_sign = 1.0 if rng.random() < 0.5 else -1.0
+        value = axis.bias + axis.noise * _skew_normal_unit(axis.skew, z0, z1)
+        if axis.drift:
+            value += axis.drift * (1.0 - math.exp(-k / max(axis.drift_tau, 1e-9)))
+        value += direction * axis.backlash / 2.0
+        if outlier:
+            value += (
+                outlier_sign * axis.outlier_size * max(axis.noise, self.gauge(channel).resolution)
+            )
+        return value
+
+    def value(self, channel: str, k: int, seed: int) -> float:
+        """The k-th displayed reading of ``channel``."""
+        return self.gauge(channel).show(self.true_value(channel, k, seed))
+
+
+class RampModel(RobotModel):
+    """Every reading distinct: ``start + k × step`` per channel, wrapping inside the gauge range.
+
+    For checking a line end to end: a lost, invented or duplicated reading is visible by value
+    (the reconnect tests and the reader benchmark use it).
+    """
+
+    def __init__(
+        self, channels: Sequence[str], gauge: GaugeSpec = GaugeSpec(), step: float | None = None
+    ) -> None:
+        self.channels = tuple(channels)
+        self._gauge = gauge
+        self.step = gauge.resolution if step is None else step
+        self._span = round((gauge.high - gauge.low) / self.step)
+
+    def gauge(self, channel: str) -> GaugeSpec:
+        """The indicator on ``channel``."""
+        return self._gauge
+
+    def value(self, channel: str, k: int, seed: int) -> float:
+        """``low`` + ((k + channel index × 1000 + seed) mod span) × step, at the resolution."""
+        index = self.channels.index(channel)
+        steps = (k + index * 1000 + seed) % self._span
+        return self._gauge.show(self._gauge.low + steps * self.step)
+
+
+@dataclass(frozen=True)
+class Faults:
+    """Fault injection rates (probability per frame sent) and the disconnect schedule.
+
+    * ``garbage_rate``: a line of noise bytes (ending with the terminator) before the frame.
+    * ``torn_rate``: the frame is written in two pieces with a short pause (must be rejoined).
+    * ``error_rate``: an error/status frame of the protocol instead of the reading.
+    * ``silence_rate``: no answer to a request (a pushed set is skipped).
+    * ``stale_rate``: after the frame, copies of up to ``stale_count`` earlier frames (old
+      frames delivered late).
+    * ``disconnect_every``: seconds between disconnects (0 = never); each lasts ``down_time``.
+    """
+
+    garbage_rate: float = 0.0
+    torn_rate: float = 0.0
+    error_rate: float = 0.0
+    silence_rate: float = 0.0
+    stale_rate: float = 0.0
+    stale_count: int = 3
+    disconnect_every: float = 0.0
+    down_time: float = 1.0
+    torn_pause: float = 0.02
+
+    def __post_init__(self) -> None:
+        for name in ("garbage_rate", "torn_rate", "error_rate", "silence_rate", "stale_rate"):
+            rate = getattr(self, name)
+            if not 0.0 <= rate <= 1.0:
+                raise StationError(f"The {name.replace('_', ' ')} must lie in 0..1, not {rate}.")
+
+
+@dataclass
+class SentFrame:
+    """A reading the simulator sent: which channel, its index k, the value and the bytes."""
+
+    channel: str
+    k: int
+    value: float
+    frame: bytes
+    t_mono: float
+
+
+@dataclass
+class _Link:
+    """Where the simulator's side of the line is, and how to rebuild it after a disconnect."""
+
+    kind: str
+    url: str = ""
+    master: int | None = None
+    slave: int | None = None
+    link_path: Path | None = None
+    own_dir: Path | None = None
+    listener: socket.socket | None = None
+    conn: socket.socket | None = None
+    port: int = 0
+
+
+class Simulator:
+    """Serve ``model``'s readings in ``protocol``'s frames, with ``faults``, on a pty or TCP.
+
+    ``channel_map`` maps device channels to the model's channels (default ``1``, ``2``, ``3``
+    … in the model's order, or the protocol's own channels when it lists enough). ``push_rate``
+    (sets per second) makes a push device send by itself; 0 means push only on :meth:`push`.
+    Polled protocols answer requests and zero commands. :attr:`sent` records every reading
+    sent, per channel, for tests to compare with.
+    """
+
+    def __init__(
+        self,
+        protocol: Protocol,
+        model: RobotModel,
+        faults: Faults | None = None,
+        seed: int = 0,
+        *,
+        channel_map: Mapping[str, str] | None = None,
+        push_rate: float = 0.0,
+        answer_delay: float = 0.0,
+    ) -> None:
+        self.protocol = protocol
+        self.model = model
+        self.faults = faults or Faults()
+        self.seed = seed
+        self.push_rate = push_rate
+        self.answer_delay = answer_delay
+        if channel_map is None:
+            own = tuple(protocol.channels)
+            devices = (
+                own
+                if len(own) >= len(model.channels)
+                else tuple(str(i + 1) for i in range(len(model.channels)))
+            )
+            channel_map = dict(zip(devices, model.channels, strict=False))
+        self.channel_map = dict(channel_map)
+        self._check_channels()
+        self.sent: dict[str, list[SentFrame]] = {c: [] for c in self.channel_map.values()}
+        self.zero_requests: list[str] = []
+        self.zero_offsets: dict[str, float] = {}
+        """Per channel, the value the gauge showed when its zero command came (then subtracted)."""
+        self.dropped_bytes = 0
+        self.disconnects = 0
+        self._k = dict.fromkeys(self.channel_map.values(), 0)
+        self._fault_rng = random.Random(f"faults/{seed}")
+        self._recent: deque[bytes] = deque(maxlen=16)
+        self._requests = self._command_table(protocol.request)
+        self._zeros = self._command_table(protocol.zero_command)
+        self._inbox = b""
+        self._lock = threading.RLock()
+        self._stopping = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._link: _Link | None = None
+        self._down_until = 0.0
+        self._connected = threading.Event()
+
+    # -- configuration checks ------------------------------------------------------------
+
+    def _check_channels(self) -> None:
+        unknown = [c for c in self.channel_map.values() if c not in self.model.channels]
+        if unknown:
+            raise StationError(
+                f"The simulator has no channel {', '.join(unknown)}: its channels are "
+                f"{', '.join(self.model.channels)}."
+            )
+        if len(self.channel_map) > 1:
+            # A format that cannot carry the channel (one gauge per port) would merge channels.
+            for device in self.channel_map:
+                gauge = self.model.gauge(self.channel_map[device])
+                frame = self.protocol.encode(device, 0.0, gauge.resolution, gauge.unit)
+                parsed = self.protocol.parse(frame.rstrip(b"\r\n"))
+                if getattr(parsed, "device_channel", device) != device:
+                    raise StationError(
+                        f"The {self.protocol.name} protocol carries one gauge per port: run one "
+                        "simulator per channel (e.g. --channels x), or use a multiplexed "
+                        "protocol such as mitutoyo."
+                    )
+
+    def _command_table(self, builder) -> dict[bytes, list[str]]:
+        table: dict[bytes, list[str]] = {}
+        for device in self.channel_map:
+            command = builder(device)
+            if command:
+                table.setdefault(command, []).append(device)
+        return table
+
+    # -- life cycle ----------------------------------------------------------------------
+
+    @property
+    def url(self) -> str:
+        """What a reader opens: the pty path (or its stable link) or ``socket://127.0.0.1:P``."""
+        return self._link.url if self._link else ""
+
+    def start_pty(self, link: str | os.PathLike | bool | None = None) -> str:
+        """Serve on a new pseudo-terminal; return the path to open.
+
+        ``link``: a path for a symlink to the pty that survives disconnects, ``True`` for one in
+        a private temporary folder, None for the plain ``/dev/pts/N`` (then a disconnect comes
+        back on whatever pty number the kernel gives). A disconnect schedule in the faults
+        implies ``True``.
+        """
+        if link is None and self.faults.disconnect_every > 0:
+            link = True
+        state = _Link("pty")
+        if link is True:
+            state.own_dir = Path(tempfile.mkdtemp(prefix="station-sim-"))
+            state.link_path = state.own_dir / "gauge"
+        elif link:
+            state.link_path = Path(link)
+        self._link = state
+        self._open_pty()
+        state.url = str(state.link_path) if state.link_path else os.ttyname(state.slave)
+        self._start_thread()
+        return state.url
+
+    def start_tcp(self, port: int = 0) -> str:
+        """Serve on TCP 127.0.0.1:``port`` (0 = a free port); return ``socket://127.0.0.1:P``."""
+        state = _Link("tcp", port=port)
+        self._link = state
+        self._listen()
+        state.url = f"socket://127.0.0.1:{state.port}"
+        self._start_thread()
+        return state.url
+
+    def _start_thread(self) -> None:
+        self._stopping.clear()
+        self._thread = threading.Thread(target=self._serve, name="gauge-simulator", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        """Stop serving, close the line and remove any link this simulator made."""
+        self._stopping.set()
+        if self._thread is not None:
+            self._thread.join(2.0)
+            self._thread = None
+        with self._lock:
+            self._close_line(listener=True)
+            state = self._link
+            if state and state.link_path is not None:
+                with contextlib.suppress(OSError):
+                    state.link_path.unlink()
+            if state and state.own_dir is not None:
+                shutil.rmtree(state.own_dir, ignore_errors=True)
+
+    def __enter__(self) -> Simulator:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.stop()
+
+    # -- the line ------------------------------------------------------------------------
+
+    def _open_pty(self) -> None:
+        state = self._link
+        master, slave = os.openpty()
+        # The slave starts cooked (echo, CR->LF): make it raw before anything can touch it.
+        tty.setraw(slave)
+        os.set_blocking(master, False)
+        state.master, state.slave = master, slave
+        if state.link_path is not None:
+            temporary = state.link_path.with_name(state.link_path.name + ".new")
+            with contextlib.suppress(FileNotFoundError):
+                temporary.unlink()
+            os.symlink(os.ttyname(slave), temporary)
+            os.replace(temporary, state.link_path)
+        self._connected.set()
+
+    def _listen(self) -> None:
+        state = self._link
+        listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        listener.bind(("127.0.0.1", state.port))
+        listener.listen(1)
+        state.listener = listener
+        state.port = listener.getsockname()[1]
+        self._connected.set()
+
+    def _close_line(self, listener: bool) -> None:
+        state = self._link
+        if state is None:
+            return
+        self._connected.clear()
+        if state.link_path is not None:
+            # While down the link must not point at a pty number the kernel may hand to
+            # someone else: the reader then sees "no such port" until the return.
+            with contextlib.suppress(OSError):
+                state.link_path.unlink()
+        for name in ("master", "slave"):
+            fd = getattr(state, name)
+            if fd is not None:
+                with contextlib.suppress(OSError):
+                    os.close(fd)
+                setattr(state, name, None)
+        if state.conn is not None:
+            with contextlib.suppress(OSError):
+                state.conn.close()
+            state.conn = None
+        if listener and state.listener is not None:
+            with contextlib.suppress(OSError):
+                state.listener.close()
+            state.listener = None
+        self._inbox = b""
+
+    def disconnect(self, down_time: float | None = None) -> None:
+        """Drop the line now (pty master closed / TCP server gone) and return after ``down_time``.
+
+        The return happens on the serving thread; :meth:`wait_up` waits for it.
+        """
+        with self._lock:
+            self.disconnects += 1
+            self._close_line(listener=True)
+            self._down_until = time.monotonic() + (
+                self.faults.down_time if down_time is None else down_time
+            )
+
+    def wait_up(self, timeout: float = 5.0) -> bool:
+        """Wait until the line is back after a disconnect."""
+        return self._connected.wait(timeout)
+
+    def _come_back(self) -> None:
+        with self._lock:
+            if self._link.kind == "pty":
+                self._open_pty()
+            else:
+                self._listen()
+            self._down_until = 0.0
+
+    def _write(self, data: bytes) -> bool:
+        """Write all of ``data`` to the reader's side; False (and counted) when it cannot."""
+        state = self._link
+        if state is None:
+            return False
+        if state.kind == "tcp":
+            if state.conn is None:
+                self.dropped_bytes += len(data)
+                return False
+            try:
+                state.conn.sendall(data)
+                return True
+            except OSError:
+                self._drop_client()
+                self.dropped_bytes += len(data)
+                return False
+        if state.master is None:
+            self.dropped_bytes += len(data)
+            return False
+        view = memoryview(data)
+        # Nobody drains the pty (no reader yet): wait briefly, then drop, so the server stays
+        # responsive; the reader flushes on open anyway.
+        deadline = time.monotonic() + 0.1
+        while view:
+            try:
+                written = os.write(state.master, view)
+                view = view[written:]
+            except BlockingIOError:
+                # The reader is not draining the pty; wait a little, then give up on this frame.
+                if time.monotonic() > deadline:
+                    self.dropped_bytes += len(view)
+                    return False
+                select.select([], [state.master], [], 0.05)
+            except OSError:
+                self.dropped_bytes += len(view)
+                return False
+        return True
+
+    def _drop_client(self) -> None:
+        state = self._link
+        if state is not None and state.conn is not None:
+            with contextlib.suppress(OSError):
+                state.conn.close()
+            state.conn = None
+
+    # -- serving -------------------------------------------------------------------------
+
+    def _serve(self) -> None:
+        next_push: float | None = None
+        every = self.faults.disconnect_every
+        next_disconnect = time.monotonic() + every if every > 0 else math.inf
+        while not self._stopping.is_set():
+            now = time.monotonic()
+            if self._down_until:
+                if now >= self._down_until:
+                    self._come_back()
+                    next_push = None
+                else:
+                    self._stopping.wait(min(0.02, self._down_until - now))
+                continue
+            if now >= next_disconnect:
+                self.disconnect()
+                next_disconnect = now + every
+                continue
+            rate = self.push_rate
+            if rate <= 0:
+                next_push = None  # the schedule starts afresh when a rate is set
+            else:
+                if next_push is None or now - next_push > 1.0:
+                    next_push = now  # never burst a backlog a real device would not send
+                if now >= next_push:
+                    due = min(int((now - next_push) * rate) + 1, 100)
+                    self.push(due)
+                    next_push += due / rate
+            wait = 0.05
+            if next_push is not None:
+                wait = max(0.0, min(wait, next_push - time.monotonic()))
+            self._wait_for_input(wait)
+
+    def _wait_for_input(self, wait: float) -> None:
+        state = self._link
+        with self._lock:
+            if state.kind == "pty":
+                sources = [state.master] if state.master is not None else []
+            else:
+                sources = [s for s in (state.listener, state.conn) if s is not None]
+        if not sources:
+            self._stopping.wait(wait)
+            return
+        try:
+            ready, _, _ = select.select(sources, [], [], wait)
+        except (OSError, ValueError):
+            return  # a descriptor closed under us by disconnect(); the loop sees the new state
+        for source in ready:
+            with self._lock:
+                if state.kind == "pty":
+                    if source != state.master:
+                        continue
+                    try:
+                        data = os.read(state.master, 4096)
+                    except (BlockingIOError, OSError):
+                        continue
+                    self._received(data)
+                elif source is state.listener and state.listener is not None:
+                    conn, _ = state.listener.accept()
+                    conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+                    self._drop_client()  # one client at a time, like a serial line
+                    state.conn = conn
+                    self._inbox = b""
+                elif source is state.conn and state.conn is not None:
+                    try:
+                        data = state.conn.recv(4096)
+                    except OSError:
+                        data = b""
+                    if not data:
+                        self._drop_client()
+                        continue
+                    self._received(data)
+
+    def _received(self, data: bytes) -> None:
+        """Find requests and zero commands in the incoming bytes and answer them in order."""
+        self._inbox += data
+        commands = {
+            **{c: ("read", d) for c, d in self._requests.items()},
+            **{c: ("zero", d) for c, d in self._zeros.items()},
+        }
+        longest = max((len(c) for c in commands), default=1)
+        while self._inbox:
+            found = [(self._inbox.find(c), c) for c in commands]
+            found = [(i, c) for i, c in found if i >= 0]
+            if not found:
+                self._inbox = self._inbox[-(longest - 1) :] if longest > 1 else b""
+                return
+            index, command = min(found, key=lambda item: (item[0], -len(item[1])))
+            self._inbox = self._inbox[index + len(command) :]
+            kind, devices = commands[command]
+            if kind == "zero":
+                for device in devices:
+                    self._zero(self.channel_map[device])
+                continue
+            if self.answer_delay:
+                time.sleep(self.answer_delay)
+            for device in devices:
+                self._send_reading(device, can_be_silent=True)
+
+    def push(self, sets: int = 1) -> None:
+        """Send ``sets`` reading sets now (one frame per channel), as a DATA press would."""
+        with self._lock:
+            for _ in range(sets):
+                silent = self._chance(self.faults.silence_rate)
+                for device in self.channel_map:
+                    if not silent:
+                        self._send_reading(device, can_be_silent=False)
+
+    def stale_burst(self, count: int | None = None) -> None:
+        """Send copies of the last ``count`` frames again now (old frames delivered late)."""
+        with self._lock:
+            count = self.faults.stale_count if count is None else count
+            old = list(self._recent)[-count:] if count else []
+            if old:
+                self._write(b"".join(old))
+
+    def inject(self, reason: str, device_channel: str | None = None) -> bytes:
+        """Send the protocol's ``reason`` frame (``error``/``status``) now; returns the bytes."""
+        device = device_channel or next(iter(self.channel_map))
+        frames = self.protocol_fault_frames(device)
+        if reason not in frames:
+            raise StationError(
+                f"The {self.protocol.name} protocol has no {reason} frame; it has "
+                f"{', '.join(frames) or 'none'}."
+            )
+        with self._lock:
+            self._write(frames[reason])
+        return frames[reason]
+
+    def protocol_fault_frames(self, device_channel: str) -> dict[str, bytes]:
+        """The protocol's example error/status frames for ``device_channel``."""
+        getter = getattr(self.protocol, "fault_frames", None)
+        return dict(getter(device_channel)) if getter else {}
+
+    def _chance(self, rate: float) -> bool:
+        # Always draw, so that one fault's rate does not shift the others' decisions.
+        return self._fault_rng.random() < rate
+
+    def _send_reading(self, device: str, can_be_silent: bool) -> None:
+        faults = self.faults
+        silent = self._chance(faults.silence_rate)
+        error = self._chance(faults.error_rate)
+        garbage = self._chance(faults.garbage_rate)
+        torn = self._chance(faults.torn_rate)
+        stale = self._chance(faults.stale_rate)
+        if can_be_silent and silent:
+            return
+        if error:
+            frames = self.protocol_fault_frames(device)
+            frame = frames.get("error") or frames.get("status")
+            if frame:
+                self._write(frame)
+                return
+        channel = self.channel_map[device]
+        gauge = self.model.gauge(channel)
+        k = self._k[channel]
+        value = self.expected(channel, k)
+        frame = self.protocol.encode(device, value, gauge.resolution, gauge.unit)
+        if garbage:
+            noise = bytes(
+                self._fault_rng.choice(_GARBAGE_BYTES)
+                for _ in range(self._fault_rng.randint(1, 12))
+            )
+            self._write(noise + self.protocol.terminator)
+        if torn and len(frame) > 2:
+            cut = self._fault_rng.randint(1, len(frame) - 1)
+            delivered = self._write(frame[:cut])
+            time.sleep(faults.torn_pause)
+            delivered = self._write(frame[cut:]) and delivered
+        else:
+            delivered = self._write(frame)
+        if not delivered:
+            return  # the line is down: this value was never seen, and k is not used up
+        self._k[channel] = k + 1
+        self.sent[channel].append(SentFrame(channel, k, value, frame, time.monotonic()))
+        if stale and self._recent:
+            self._write(b"".join(list(self._recent)[-faults.stale_count :]))
+        self._recent.append(frame)
+
+    # -- for tests and the demo ---------------------------------------------------------
+
+    def expected(self, channel: str, k: int) -> float:
+        """The value the k-th reading of ``channel`` shows (sent or not), after any zeroing."""
+        value = self.model.value(channel, k, self.seed)
+        offset = self.zero_offsets.get(channel)
+        if offset is None:
+            return value
+        return self.model.gauge(channel).show(value - offset)
+
+    def _zero(self, channel: str) -> None:
+        """The device's zero key: what it shows now (its last reading) becomes 0."""
+        self.zero_requests.append(channel)
+        last = self.sent[channel][-1].k if self.sent[channel] else 0
+        self.zero_offsets[channel] = self.model.value(channel, last, self.seed)
+
+    def sent_values(self, channel: str) -> list[float]:
+        """The values sent so far on ``channel``, in order."""
+        with self._lock:
+            return [s.value for s in self.sent[channel]]
+
+    def wait_client(self, timeout: float = 5.0) -> bool:
+        """TCP: wait until a reader has connected."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            state = self._link
+            if state is not None and (state.kind == "pty" or state.conn is not None):
+                return True
+            time.sleep(0.01)
+        return False
+
+
+def fixture_model(
+    channels: Sequence[str],
+    *,
+    axis: AxisModel | Mapping[str, AxisModel] = AxisModel(),
+    gauge: GaugeSpec = GaugeSpec(),
+) -> FixtureModel:
+    """A :class:`FixtureModel` with the same (or a per-channel) axis model on ``channels``."""
+    if isinstance(axis, Mapping):
+        axes = {c: axis.get(c, AxisModel()) for c in channels}
+    else:
+        axes = dict.fromkeys(channels, axis)
+    return FixtureModel(axes, gauge)
+
+
+def demo_model(channels: Sequence[str] = ("x", "y", "z"), unit: str = "in") -> FixtureModel:
+    """A fixture like the report's Table 2-1 (X: mean +0.00008 in, σ 0.00026 in, a₁ ≈ −0.36).
+
+    Every axis has that spread at a 0.0001 in (0.001 mm) indicator; y sits a little off
+    nominal with a short warm-up drift, z has some backlash and a rare outlier, so the demo's
+    verdicts, histograms and control-chart rules have something to show.
+    """
+    scale = 25.4 if unit == "mm" else 1.0
+    resolution = 0.001 if unit == "mm" else 0.0001
+    base = AxisModel(bias=0.00008 * scale, noise=0.00026 * scale, skew=-2.0)
+    variants = [
+        base,
+        AxisModel(
+            bias=0.00025 * scale,
+            noise=0.00022 * scale,
+            skew=-1.0,
+            drift=0.0002 * scale,
+            drift_tau=6.0,
+        ),
+        AxisModel(
+            bias=-0.0001 * scale,
+            noise=0.00024 * scale,
+            backlash=0.0002 * scale,
+            outlier_rate=0.02,
+            outlier_size=5.0,
+        ),
+    ]
+    axes = {c: variants[i % len(variants)] for i, c in enumerate(channels)}
+    return FixtureModel(axes, GaugeSpec(resolution, -0.5 * scale, 0.5 * scale, unit))
+
+
+__all__ = [
+    "AxisModel",
+    "Faults",
+    "FixtureModel",
+    "GaugeSpec",
+    "RampModel",
+    "demo_model",
+    "RobotModel",
+    "SentFrame",
+    "Simulator",
+    "fixture_model",
+]

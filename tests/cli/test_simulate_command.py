@@ -1,0 +1,118 @@
+"""``station simulate`` as a real subprocess: URL first, the seeded model's values, clean exit."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+
+import pytest
+
+from station.instruments.protocols import get_protocol
+from station.instruments.simulator import AxisModel, FixtureModel, GaugeSpec
+from station.instruments.transport import open_port
+
+STATION = [sys.executable, "-m", "station"]
+
+
+def start(*args: str) -> tuple[subprocess.Popen, str]:
+    process = subprocess.Popen(
+        [*STATION, "simulate", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    url = process.stdout.readline().strip()
+    if not url:
+        process.kill()
+        pytest.fail(f"no URL: {process.communicate()[1]}")
+    return process, url
+
+
+def finish(process: subprocess.Popen, sig: int) -> tuple[int, str]:
+    process.send_signal(sig)
+    _, err = process.communicate(timeout=10)
+    return process.returncode, err
+
+
+def poll(url: str, name: str, times: int) -> list[bytes]:
+    protocol = get_protocol(name)
+    port = open_port(url, protocol.settings, timeout=2.0)
+    try:
+        frames = []
+        for _ in range(times):
+            port.write(protocol.request("1"))
+            frames.append(port.read_until(protocol.terminator).strip())
+        return frames
+    finally:
+        port.close()
+
+
+@pytest.mark.parametrize(("where", "sig"), [("--pty", signal.SIGTERM), ("--tcp", signal.SIGINT)])
+def test_url_first_then_the_seeded_values_then_a_clean_exit(where: str, sig: int) -> None:
+    args = [
+        "--protocol",
+        "idh",
+        "--channels",
+        "x",
+        "--seed",
+        "42",
+        "--bias",
+        "x=0.25",
+        "--noise",
+        "0.01",
+        "--skew",
+        "3",
+        "--resolution",
+        "0.0005",
+        where,
+    ]
+    if where == "--tcp":
+        args.append("0")
+    process, url = start(*args)
+    try:
+        if where == "--pty":
+            assert url.startswith("/dev/pts/")
+        else:
+            assert url.startswith("socket://127.0.0.1:") and not url.endswith(":0")
+        frames = poll(url, "idh", 4)
+    finally:
+        code, err = finish(process, sig)
+    model = FixtureModel(
+        {"x": AxisModel(bias=0.25, noise=0.01, skew=3.0)}, GaugeSpec(resolution=0.0005)
+    )
+    protocol = get_protocol("idh")
+    values = [protocol.parse(frame).value for frame in frames]
+    assert values == pytest.approx([model.value("x", k, 42) for k in range(4)], abs=1e-9)
+    assert code == 0
+    assert "Traceback" not in err
+
+
+def test_error_rate_one_sends_only_error_frames() -> None:
+    process, url = start("--protocol", "mitutoyo", "--error-rate", "1", "--channels", "x")
+    try:
+        frames = poll(url, "mitutoyo", 2)
+    finally:
+        code, _ = finish(process, signal.SIGTERM)
+    assert frames == [b"911", b"911"]
+    assert code == 0
+
+
+@pytest.mark.parametrize(
+    ("args", "sentence"),
+    [
+        (["--protocol", "nope"], "unknown gauge protocol 'nope'"),
+        (["--protocol", "sylvac"], "carries one gauge per port"),
+        (["--protocol", "mitutoyo", "--bias", "q=1"], "--bias names channel 'q'"),
+        (["--protocol", "mitutoyo", "--error-rate", "2"], "error rate must lie in 0..1"),
+        (["--protocol", "mitutoyo", "--resolution", "-1"], "--resolution must be more than 0"),
+    ],
+)
+def test_bad_options_exit_2_with_a_sentence(args: list[str], sentence: str) -> None:
+    result = subprocess.run(
+        [*STATION, "simulate", *args], capture_output=True, text=True, timeout=30
+    )
+    assert result.returncode == 2
+    assert sentence in result.stderr
+    assert result.stdout == ""
+    assert "Traceback" not in result.stderr
