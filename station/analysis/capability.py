@@ -115,10 +115,10 @@ def _finite_or_none(value: float | None) -> float | None:
     return value if value is not None and math.isfinite(value) else None
 
 
-def _indices(
+def capability_indices(
     mean: float, sigma: float | None, lsl: float | None, usl: float | None
 ) -> tuple[float | None, float | None, float | None, float | None]:
-    """(Cp, Cpu, Cpl, Cpk) for one sigma; all None when sigma is missing or 0."""
+    """(Cp, Cpu, Cpl, Cpk) of a mean and one sigma; None where undefined (no sigma, sigma 0)."""
     if sigma is None or sigma <= 0:
         return None, None, None, None
     cp = (usl - lsl) / (6 * sigma) if usl is not None and lsl is not None else None
@@ -227,9 +227,11 @@ def capability(
                 "within sigma is 0: consecutive readings do not vary, so the within indices "
                 "are undefined"
             )
-    cp, cpu, cpl, cpk = _indices(mean, sigma, lsl, usl) if mean is not None else (None,) * 4
+    cp, cpu, cpl, cpk = (
+        capability_indices(mean, sigma, lsl, usl) if mean is not None else (None,) * 4
+    )
     cp_within, _, _, cpk_within = (
-        _indices(mean, within, lsl, usl) if mean is not None else (None,) * 4
+        capability_indices(mean, within, lsl, usl) if mean is not None else (None,) * 4
     )
     if cpk is None and not reasons:
         reasons.append(f"the indices are too large to represent (sigma {sigma:g})")

@@ -122,10 +122,10 @@ def modes_at_resolution(
     tied = distinct[counts == highest]
     if resolution is None:
         return tuple(float(v) for v in tied)
-    return tuple(_multiple(int(k), step) for k in tied)
+    return tuple(step_multiple(int(k), step) for k in tied)
 
 
-def _multiple(k: int, step: float) -> float:
+def step_multiple(k: int, step: float) -> float:
     """k * step without the binary noise (3 * 0.0001 is 0.00030000000000000003, not 0.0003)."""
     return float(f"{k * step:.12g}")
 

@@ -383,12 +383,15 @@ def check_rules(
     rule_set: str = "report",
     *,
     unit: str | None = None,
+    first_point: int = 1,
 ) -> list[Alarm]:
     """Every alarm of the rule set on the plotted points, ordered by first point then rule.
 
     ``sigma`` is the sigma of the plotted statistic, (UCL - centre) / 3 (see
     ``ControlChart.point_sigma``). With no centre or sigma (a chart without limits) there is
     nothing to check and the list is empty. ``unit`` is appended to the values in the text.
+    ``first_point`` is the chart number of ``points[0]``: the live form checks only the last
+    window of a long chart and still names the points as the chart numbers them.
     """
     rules = _rules_of(rule_set)
     values = as_readings(points, what="point")
@@ -406,7 +409,7 @@ def check_rules(
     found: list[tuple[int, int, Alarm]] = []
     for order, (rule_id, kind) in enumerate(rules):
         for side, flags in kind.check(ctx).items():
-            for run in _contiguous(np.flatnonzero(flags)):
+            for run in _contiguous(np.flatnonzero(flags) + (first_point - 1)):
                 text = kind.text(run, side, ctx, fmt)
                 found.append((run[0], order, Alarm(rule_id, tuple(run), text)))
     found.sort(key=lambda item: (item[0], item[1]))

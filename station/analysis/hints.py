@@ -1,0 +1,126 @@
+"""Verdict hints: what the figures suggest to look at, in the words of the report (§2.7.1–2.7.2).
+
+Each hint is one sentence that names the channel and the figure behind it. They are hints, not
+verdicts: the verdict is the capability index; these point the technician at a likely cause.
+
+* Skewness: the report says a₁ "close to the value of +1 or higher" means a highly skewed
+  histogram, "usually attributed to an instability in the robot's control system". We read
+  "close to 1" as |a₁| ≥ 0.8 (:data:`SKEW_HINT`).
+* Offset: "if the average value does not coincide with the nominal value", the error "could be
+  attributed to the linearization of the inverse kinematics software and/or the effect of the
+  ambient temperature". With 25–30 noisy readings the average never equals the nominal exactly,
+  so the hint fires only when the offset is statistically clear: |X̄ − nominal| greater than the
+  two-sided 95 % t-interval half-width t(0.975, n−1)·s/√n.
+* Shift: Cp ≥ threshold but Cpk < threshold means the spread fits the tolerance but the process
+  sits off centre (the report's Cpk1/Cpk2 "shift off the nominal value").
+* Rule alarms: a pattern on the control chart; look at the cycles it names.
+* Gauge too coarse: a tolerance narrower than 10 gauge steps (the usual 10:1 rule for
+  measurement resolution) makes the verdict rest on a handful of distinct readings.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from station.analysis.capability import Capability, SpecLimits
+from station.analysis.descriptive import Descriptive
+from station.analysis.rules import Alarm
+
+#: |a₁| at or above this is "close to 1 or higher" (report §2.7.1).
+SKEW_HINT = 0.8
+#: The tolerance should span at least this many gauge steps.
+RESOLUTION_RATIO = 10.0
+
+
+def _figure(value: float, unit: str) -> str:
+    return f"{value:+.3g} {unit}".rstrip()
+
+
+def _points(points: Sequence[int]) -> str:
+    if len(points) == 1:
+        return f"point {points[0]}"
+    if len(points) > 2 and points[-1] - points[0] == len(points) - 1:
+        return f"points {points[0]}-{points[-1]}"
+    return "points " + ", ".join(str(p) for p in points)
+
+
+def offset_is_clear(descriptive: Descriptive, nominal: float) -> bool:
+    """True when the mean differs from nominal beyond its two-sided 95 % t-interval."""
+    from scipy import stats
+
+    if descriptive.n < 2 or descriptive.mean is None or descriptive.sd is None:
+        return False
+    offset = abs(descriptive.mean - nominal)
+    if descriptive.sd == 0.0:
+        return offset > 0.0
+    half_width = (
+        float(stats.t.ppf(0.975, descriptive.n - 1)) * descriptive.sd / math.sqrt(descriptive.n)
+    )
+    return offset > half_width
+
+
+def channel_hints(
+    name: str,
+    descriptive: Descriptive,
+    capability: Capability,
+    alarms: Sequence[Alarm],
+    *,
+    limits: SpecLimits | None,
+    nominal: float,
+    resolution: float | None,
+    unit: str = "",
+) -> list[str]:
+    """The hints for one channel, each a sentence naming the channel and the figure."""
+    hints: list[str] = []
+    skew = descriptive.skewness
+    if skew is not None and abs(skew) >= SKEW_HINT:
+        side = "right" if skew > 0 else "left"
+        hints.append(
+            f"{name}: skewness a1 = {skew:+.3f} is near 1 or beyond (histogram skewed to the "
+            f"{side}); the report attributes this to an instability in the robot's control "
+            "system: correct it before trusting the verdict."
+        )
+    if descriptive.mean is not None and offset_is_clear(descriptive, nominal):
+        offset = descriptive.mean - nominal
+        hints.append(
+            f"{name}: the average is {_figure(offset, unit)} off nominal "
+            f"({_figure(nominal, unit)}), more than chance explains with {descriptive.n} "
+            "readings; the report attributes this to the linearisation of the inverse "
+            "kinematics or to the ambient temperature."
+        )
+    threshold = capability.threshold
+    if (
+        capability.cp is not None
+        and capability.cpk is not None
+        and capability.cp >= threshold
+        and capability.cpk < threshold
+    ):
+        hints.append(
+            f"{name}: Cp = {capability.cp:.2f} meets {threshold:g} but Cpk = "
+            f"{capability.cpk:.2f} does not: the spread fits the tolerance but the process "
+            "has shifted off nominal; re-centre it (re-teach or compensate the offset)."
+        )
+    if alarms:
+        fired = "; ".join(f"{alarm.rule} at {_points(alarm.points)}" for alarm in alarms[:6])
+        more = f"; and {len(alarms) - 6} more" if len(alarms) > 6 else ""
+        hints.append(
+            f"{name}: the control chart shows a pattern ({fired}{more}); look at those cycles "
+            "for a cause (warm-up, a bumped fixture, a loose indicator) before trusting the "
+            "verdict."
+        )
+    if (
+        resolution
+        and limits is not None
+        and limits.lsl is not None
+        and limits.usl is not None
+        and (limits.usl - limits.lsl) < RESOLUTION_RATIO * resolution
+    ):
+        steps = (limits.usl - limits.lsl) / resolution
+        hints.append(
+            f"{name}: the tolerance {_figure(limits.usl - limits.lsl, unit).lstrip('+')} spans "
+            f"only {steps:.3g} gauge steps of {resolution:g} (fewer than "
+            f"{RESOLUTION_RATIO:g}); the gauge is too coarse for this verdict: use a finer "
+            "indicator."
+        )
+    return hints

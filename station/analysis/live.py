@@ -1,0 +1,339 @@
+"""The live (incremental) analysis behind the capture dashboard: one reading in, figures out.
+
+:meth:`LiveChannel.add` costs the same at the 100 000th reading as at the first: it updates
+running sums and returns a :class:`LiveUpdate` with the figures the dashboard shows between
+redraws (n, mean, sd, skewness, modes, min, max, range, the chart's centre and limits, Cp/Cpk
+and the verdict) and the run-rule alarms the new point raises.
+
+* Mean, sd and the third central moment: Welford's update extended to the third moment
+  (Pébay 2008), stable where the naive power sums cancel, on the readings minus the first
+  one so that an indicator far from zero keeps its digits.
+* Modes: a count per gauge step (per exact value without a resolution) and the set of steps
+  tied at the highest count.
+* Within sigma and chart limits: the running sum of moving ranges (single readings) or of the
+  complete subgroups' ranges or SDs, as :mod:`charts` defines them.
+* Capability: the report's indices from the running mean and sd, with the same formulas as
+  :func:`capability.capability`.
+
+These running figures equal the batch ones to rounding: 1e-12 relative in the tests, except for
+readings far from zero with a very fine spread, where the batch's own two-pass rounding
+(about eps·|x|/s) is the larger error and the live form, shifted by its first reading, the
+more exact.
+
+**Alarms.** The control limits move with every reading, so a point that was inside the
+2-sigma zone at the 10th reading may be outside it at the 30th; a truly incremental alarm list
+would have to re-judge old points whenever a limit crosses them. We split the job:
+
+* ``add()`` checks only the windows the new point completes (the last 15 points, the longest
+  pattern of any rule set) against the limits as they are now. This is O(1) and tells the
+  runner at once that "point 17 is above the upper control limit". The rules it returns are
+  exactly the batch alarms that flag the newest point of the same readings (tested at every
+  reading); their ``points`` reach back at most 15 points. Later readings move the limits and
+  may flag or clear *earlier* points: only the snapshot sees that.
+* ``snapshot()`` re-evaluates every rule over all points against the current limits, lazily
+  (at most once between two readings, cached) — that is, at most once per redraw. Its alarms,
+  like the whole snapshot, are exactly those of the batch :func:`summary.analyze_channel` on
+  the same readings, because it *is* that computation on the stored readings.
+
+So the dashboard reads ``snapshot()`` (once per redraw, O(n) in numpy, as drawing the chart
+is anyway) and the journal records ``add()``'s alarms as they happen.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from station.analysis.capability import SpecLimits, capability_indices, cpk_lower_bound
+from station.analysis.charts import LARGEST_RANGE_SUBGROUP, chart_type
+from station.analysis.constants import SIGMA_MULTIPLE, chart_factors
+from station.analysis.descriptive import step_multiple
+from station.analysis.rules import Alarm, check_rules
+from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis, combine
+
+#: The longest window any rule looks back over (15 points: report rule 3, Nelson 7).
+RULE_WINDOW = 15
+
+
+@dataclass(frozen=True)
+class LiveUpdate:
+    """The figures after one more reading (undefined ones are None).
+
+    ``alarms`` are the rule alarms that flag the new point (its 1-based number is ``n`` for
+    single readings; the subgroup's number when a subgroup was just completed), judged against
+    the limits as they stand now.
+    """
+
+    channel: str
+    n: int
+    value: float
+    mean: float | None
+    sd: float | None
+    skewness: float | None
+    modes: tuple[float, ...]
+    min: float | None
+    max: float | None
+    range: float | None
+    sigma_within: float | None
+    center: float | None
+    ucl: float | None
+    lcl: float | None
+    cp: float | None
+    cpu: float | None
+    cpl: float | None
+    cpk: float | None
+    cpk_lower: float | None
+    cp_within: float | None
+    cpk_within: float | None
+    capable: bool | None
+    above_usl: int
+    below_lsl: int
+    alarms: tuple[Alarm, ...]
+
+
+class LiveChannel:
+    """Running analysis of one channel; ``add`` is O(1), ``snapshot`` equals the batch result.
+
+    ``config`` gives the channel's limits (none: no capability verdict, as in the batch analysis),
+    the resolution, subgroup, rule set, threshold and confidence.
+    """
+
+    def __init__(self, name: str, config: AnalysisConfig) -> None:
+        self.name = name
+        self.config = config
+        self.limits: SpecLimits | None = config.limits_for(name)
+        self._values: list[float] = []
+        # Moments of the readings minus the first one: readings far from 0 (an indicator not
+        # zeroed) would otherwise lose digits in the running mean.
+        self._origin = 0.0
+        self._shifted_mean = 0.0
+        self._m2 = 0.0
+        self._m3 = 0.0
+        self._min = math.inf
+        self._max = -math.inf
+        self._above = 0
+        self._below = 0
+        # Modes: count per gauge step (or per exact value), and the keys tied at the top.
+        self._step_counts: dict[float, int] = {}
+        self._top_count = 0
+        self._top_keys: set[float] = set()
+        # Chart: the plotted points (individuals or subgroup means) and the running dispersion.
+        self._subgroup = config.subgroup
+        self._factors = chart_factors(config.subgroup)
+        self._points: list[float] = []
+        self._spread_sum = 0.0  # sum of moving ranges, subgroup ranges or subgroup SDs
+        self._spread_count = 0
+        self._open_group: list[float] = []
+        self._points_sum = 0.0
+        self._snapshot: ChannelAnalysis | None = None
+
+    @property
+    def n(self) -> int:
+        """Readings added so far."""
+        return len(self._values)
+
+    @property
+    def values(self) -> list[float]:
+        """A copy of the readings in the order they were added."""
+        return list(self._values)
+
+    def add(self, value: float) -> LiveUpdate:
+        """Add one reading (a finite number) and return the updated figures."""
+        x = float(value)
+        if not math.isfinite(x):
+            from station.errors import StationError
+
+            raise StationError(
+                f"{self.name}: reading {len(self._values) + 1} is not a finite number ({value!r})"
+            )
+        previous = self._values[-1] if self._values else None
+        self._values.append(x)
+        self._snapshot = None
+        n = len(self._values)
+
+        # Welford / Pébay: update the third moment with the old second moment first.
+        if n == 1:
+            self._origin = x
+        delta = (x - self._origin) - self._shifted_mean
+        delta_n = delta / n
+        term = delta * delta_n * (n - 1)
+        self._shifted_mean += delta_n
+        self._m3 += term * delta_n * (n - 2) - 3.0 * delta_n * self._m2
+        self._m2 += term
+        self._min = min(self._min, x)
+        self._max = max(self._max, x)
+        if self.limits is not None:
+            if self.limits.usl is not None and x > self.limits.usl:
+                self._above += 1
+            if self.limits.lsl is not None and x < self.limits.lsl:
+                self._below += 1
+        self._count_mode(x)
+
+        new_point = False
+        if self._subgroup == 1:
+            self._points.append(x)
+            self._points_sum += x
+            if previous is not None:
+                self._spread_sum += abs(x - previous)
+                self._spread_count += 1
+            new_point = True
+        else:
+            self._open_group.append(x)
+            if len(self._open_group) == self._subgroup:
+                self._close_group()
+                new_point = True
+        return self._update(x, new_point)
+
+    def _count_mode(self, x: float) -> None:
+        step = self.config.resolution
+        key = float(math.floor(x / step + 0.5)) if step else x
+        count = self._step_counts.get(key, 0) + 1
+        self._step_counts[key] = count
+        if count > self._top_count:
+            self._top_count = count
+            self._top_keys = {key}
+        elif count == self._top_count:
+            self._top_keys.add(key)
+
+    def _close_group(self) -> None:
+        group = self._open_group
+        self._open_group = []
+        size = len(group)
+        group_mean = sum(group) / size
+        if size <= LARGEST_RANGE_SUBGROUP:
+            spread = max(group) - min(group)
+        else:
+            spread = math.sqrt(sum((v - group_mean) ** 2 for v in group) / (size - 1))
+        self._points.append(group_mean)
+        self._points_sum += group_mean
+        self._spread_sum += spread
+        self._spread_count += 1
+
+    def modes(self) -> tuple[float, ...]:
+        """Every most frequent value at the resolution, ascending; empty when none repeats."""
+        if self._top_count < 2:
+            return ()
+        step = self.config.resolution
+        if step:
+            return tuple(step_multiple(int(key), step) for key in sorted(self._top_keys))
+        return tuple(sorted(self._top_keys))
+
+    def _sigma_within(self) -> float | None:
+        if self._spread_count == 0:
+            return None
+        spread = self._spread_sum / self._spread_count
+        kind = chart_type(self._subgroup)
+        if kind == "Xbar-S":
+            return spread / self._factors.c4
+        return spread / self._factors.d2
+
+    def _update(self, x: float, new_point: bool) -> LiveUpdate:
+        n = len(self._values)
+        mean = self._origin + self._shifted_mean
+        sd = math.sqrt(self._m2 / (n - 1)) if n >= 2 else None
+        skewness = None
+        if n >= 3 and self._m2 > 0:
+            skewness = (self._m3 / n) / (self._m2 / (n - 1)) ** 1.5
+        within = self._sigma_within()
+        center = ucl = lcl = None
+        if within is not None:
+            center = self._points_sum / len(self._points)
+            half_width = SIGMA_MULTIPLE * within / math.sqrt(self._subgroup)
+            ucl, lcl = center + half_width, center - half_width
+        cp = cpu = cpl = cpk = cpk_lower = cp_within = cpk_within = None
+        if self.limits is not None and n >= 2:
+            lsl, usl = self.limits.lsl, self.limits.usl
+            cp, cpu, cpl, cpk = capability_indices(mean, sd, lsl, usl)
+            cp_within, _, _, cpk_within = capability_indices(mean, within, lsl, usl)
+            if cpk is not None:
+                cpk_lower = cpk_lower_bound(cpk, n, self.config.confidence)
+        alarms: tuple[Alarm, ...] = ()
+        if new_point and center is not None and ucl is not None and ucl > center:
+            alarms = self._newest_point_alarms(center, (ucl - center) / SIGMA_MULTIPLE)
+        return LiveUpdate(
+            channel=self.name,
+            n=n,
+            value=x,
+            mean=mean,
+            sd=sd,
+            skewness=skewness,
+            modes=self.modes(),
+            min=self._min,
+            max=self._max,
+            range=self._max - self._min,
+            sigma_within=within,
+            center=center,
+            ucl=ucl,
+            lcl=lcl,
+            cp=cp,
+            cpu=cpu,
+            cpl=cpl,
+            cpk=cpk,
+            cpk_lower=cpk_lower,
+            cp_within=cp_within,
+            cpk_within=cpk_within,
+            capable=None if cpk is None else cpk >= self.config.threshold,
+            above_usl=self._above,
+            below_lsl=self._below,
+            alarms=alarms,
+        )
+
+    def _newest_point_alarms(self, center: float, sigma: float) -> tuple[Alarm, ...]:
+        """Alarms flagging the newest point, from the windows it completes (O(RULE_WINDOW))."""
+        tail = self._points[-RULE_WINDOW:]
+        newest = len(self._points)
+        alarms = check_rules(
+            tail,
+            center,
+            sigma,
+            self.config.rule_set,
+            unit=self.config.unit or None,
+            first_point=newest - len(tail) + 1,
+        )
+        return tuple(alarm for alarm in alarms if newest in alarm.points)
+
+    def snapshot(self) -> ChannelAnalysis:
+        """The full analysis of the readings so far: equal to the batch analysis (cached)."""
+        if self._snapshot is None:
+            from station.analysis.summary import analyze_channel
+
+            if not self._values:
+                from station.errors import StationError
+
+                raise StationError(f"channel {self.name!r} has no readings yet.")
+            self._snapshot = analyze_channel(self.name, self._values, self.config)
+        return self._snapshot
+
+
+class LiveAnalysis:
+    """Live analysis of several channels sharing one configuration (see :class:`LiveChannel`)."""
+
+    def __init__(self, config: AnalysisConfig, channels: list[str] | tuple[str, ...] = ()) -> None:
+        self.config = config
+        self.channels: dict[str, LiveChannel] = {}
+        for name in channels:
+            self.channel(name)
+
+    def channel(self, name: str) -> LiveChannel:
+        """The live channel ``name``, created on first use."""
+        if name not in self.channels:
+            self.channels[name] = LiveChannel(name, self.config)
+        return self.channels[name]
+
+    def add(self, name: str, value: float) -> LiveUpdate:
+        """Add one reading of channel ``name``."""
+        return self.channel(name).add(value)
+
+    def add_set(self, readings: Mapping[str, float]) -> dict[str, LiveUpdate]:
+        """Add one cycle's reading set (channel → value)."""
+        return {name: self.add(name, value) for name, value in readings.items()}
+
+    def snapshot(self) -> Analysis:
+        """The whole analysis so far (channels with readings): equal to the batch ``analyze``."""
+        channels = {name: live.snapshot() for name, live in self.channels.items() if live.n}
+        if not channels:
+            from station.errors import StationError
+
+            raise StationError("no readings yet: capture a cycle first.")
+        return combine(channels, self.config)

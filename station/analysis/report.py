@@ -1,0 +1,421 @@
+"""The plain-text report, in the manner of the report's "BASIC STATISTICS COMPREHENSIVE REPORT".
+
+Per channel: maximum, average, minimum, the spec limits and nominal, sigma, range, mode, the
+pieces above and below spec, the numbered readings in three PIECE/MEASUREMENT columns, a text
+histogram with the limits marked, the control chart's limits and alarms, the capability indices
+(overall sigma as the report defines them, then the within-sigma ones and the lower confidence
+bound on Cpk, each named), and the verdict as a word. Then the 3-D figures and the hints.
+
+Plain text without colour codes so it can be filed and printed; no line is longer than
+``width``. The pieces (:func:`format_channel`, :func:`format_histogram`, :func:`format_readings`,
+:func:`verdict_word`) are public so the TUI can show them too.
+"""
+
+from __future__ import annotations
+
+import math
+import textwrap
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+from station.analysis.capability import Capability, SpecLimits
+from station.analysis.descriptive import Histogram
+from station.analysis.spatial import Spatial
+from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis
+
+if TYPE_CHECKING:
+    from station.analysis.accuracy import AccuracyAnalysis
+    from station.analysis.linearity import LinearityAnalysis
+
+
+def decimals_for(resolution: float | None, spread: float | None) -> int:
+    """Decimals that show one digit beyond the gauge step, else three significant digits of
+    the spread (the report prints 5 decimals for a 0.0001 in indicator)."""
+    if resolution:
+        return min(10, max(0, 1 - math.floor(math.log10(resolution))))
+    if spread:
+        return min(10, max(0, 2 - math.floor(math.log10(abs(spread)))))
+    return 4
+
+
+def signed(value: float | None, decimals: int) -> str:
+    """A value with its sign and fixed decimals, or "-" when undefined."""
+    return "-" if value is None else f"{value:+.{decimals}f}"
+
+
+def unsigned(value: float | None, decimals: int) -> str:
+    """A non-negative figure (range, sigma) with fixed decimals, or "-" when undefined."""
+    return "-" if value is None else f"{value:.{decimals}f}"
+
+
+def index(value: float | None) -> str:
+    """A capability index to two decimals (the report's precision), or "undefined"."""
+    return "undefined" if value is None else f"{value:.2f}"
+
+
+def verdict_word(capability: Capability) -> str:
+    """CAPABLE, NOT CAPABLE or UNDEFINED: the verdict is always a word, never only a colour."""
+    if capability.capable is None:
+        return "UNDEFINED"
+    return "CAPABLE" if capability.capable else "NOT CAPABLE"
+
+
+def _pairs(items: Sequence[tuple[str, str]], width: int) -> list[str]:
+    """Lay "LABEL: value" items out in rows of three like the report's header block, each
+    column as wide as its widest cell; one per line when three do not fit."""
+    cells = [f"{label}: {value}" for label, value in items]
+    rows = [cells[start : start + 3] for start in range(0, len(cells), 3)]
+    widths = [max(len(row[j]) for row in rows if j < len(row)) + 3 for j in range(3)]
+    if sum(widths) - 3 > width:
+        return cells
+    return ["".join(cell.ljust(widths[j]) for j, cell in enumerate(row)).rstrip() for row in rows]
+
+
+def _wrap(text: str, width: int, indent: str = "") -> list[str]:
+    return textwrap.wrap(
+        text, width=width, initial_indent=indent, subsequent_indent=indent + "  "
+    ) or [indent.rstrip()]
+
+
+def format_readings(readings: Sequence[float], decimals: int, width: int = 80) -> list[str]:
+    """The numbered readings in three PIECE / MEASUREMENT column pairs, down then across."""
+    n = len(readings)
+    rows = math.ceil(n / 3)
+    piece_width = max(5, len(str(n)))
+    measure_width = max(11, max((len(signed(v, decimals)) for v in readings), default=0))
+    pair = piece_width + 2 + measure_width
+    gap = max(2, min(6, (width - 3 * pair) // 2))
+    header = gap * " "
+    head = header.join(f"{'PIECE':>{piece_width}}  {'MEASUREMENT':>{measure_width}}" for _ in "abc")
+    lines = [head]
+    for row in range(rows):
+        cells = []
+        for column in range(3):
+            i = column * rows + row
+            if i < n:
+                cells.append(
+                    f"{i + 1:>{piece_width}}  {signed(readings[i], decimals):>{measure_width}}"
+                )
+        lines.append(header.join(cells))
+    return lines
+
+
+def format_histogram(
+    hist: Histogram,
+    limits: SpecLimits | None,
+    decimals: int,
+    width: int = 80,
+    nominal: float | None = None,
+) -> list[str]:
+    """One row per bin: its centre, a bar of '#' and the count; LSL, NOM and USL marked."""
+    counts = list(hist.counts)
+    if not counts:
+        return ["(no readings)"]
+    centres = [(lo + hi) / 2 for lo, hi in zip(hist.edges[:-1], hist.edges[1:], strict=True)]
+    label_width = max(len(signed(c, decimals)) for c in centres)
+    count_width = len(str(max(counts)))
+    marks: dict[int, list[str]] = {}
+    last = len(counts) - 1
+    for name, value in (
+        ("LSL", None if limits is None else limits.lsl),
+        ("NOM", nominal),
+        ("USL", None if limits is None else limits.usl),
+    ):
+        if value is None:
+            continue
+        for i, (lo, hi) in enumerate(zip(hist.edges[:-1], hist.edges[1:], strict=True)):
+            if lo <= value < hi or (i == last and value == hi):
+                marks.setdefault(i, []).append(name)
+                break
+    mark_width = max((len(" <" + ",".join(m)) for m in marks.values()), default=0)
+    bar_room = max(5, width - label_width - count_width - mark_width - 6)
+    top = max(counts)
+    lines = []
+    for i, (centre, count) in enumerate(zip(centres, counts, strict=True)):
+        bar = "#" * (0 if top == 0 else math.ceil(count * bar_room / top) if count else 0)
+        mark = f" <{','.join(marks[i])}" if i in marks else ""
+        lines.append(
+            f"{signed(centre, decimals):>{label_width}} |{bar.ljust(bar_room)} "
+            f"{count:>{count_width}}{mark}".rstrip()
+        )
+    if hist.below or hist.above:
+        lines.append(f"out of spec: {hist.below} below LSL, {hist.above} above USL")
+    return lines
+
+
+WITHIN_SIGMA_SOURCE = {"I-MR": "MR-bar/d2", "Xbar-R": "R-bar/d2", "Xbar-S": "S-bar/c4"}
+
+
+def _capability_lines(cap: Capability, chart_type: str, decimals: int, width: int) -> list[str]:
+    within_source = WITHIN_SIGMA_SOURCE.get(chart_type, "within subgroups")
+    lines = [
+        f"CAPABILITY (overall sigma {unsigned(cap.sigma, decimals)}, report §2.7.3)",
+        f"  Cp {index(cap.cp)}   Cpu {index(cap.cpu)}   Cpl {index(cap.cpl)}   "
+        f"Cpk {index(cap.cpk)}",
+        f"  Cpk lower 95% confidence bound (Bissell): {index(cap.cpk_lower)}",
+        f"  Within sigma {unsigned(cap.sigma_within, decimals)} ({within_source}):",
+        f"    Cp within {index(cap.cp_within)}   Cpk within {index(cap.cpk_within)}",
+    ]
+    lines = [wrapped for line in lines for wrapped in _wrap(line, width)]
+    word = verdict_word(cap)
+    if cap.capable is None:
+        reason = cap.message or "no verdict"
+        verdict = f"VERDICT: {word} ({reason})"
+    else:
+        relation = ">=" if cap.capable else "<"
+        verdict = f"VERDICT: {word} (Cpk {index(cap.cpk)} {relation} {cap.threshold:g})"
+        if cap.message:
+            verdict += f"; {cap.message}"
+    lines.extend(_wrap(verdict, width))
+    return lines
+
+
+def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int = 80) -> list[str]:
+    """The report block of one channel."""
+    d, cap, chart = channel.descriptive, channel.capability, channel.chart
+    decimals = decimals_for(config.resolution, d.sd or d.range)
+    limits = channel.limits
+    n = d.n
+    unit = f" ({config.unit})" if config.unit else ""
+    lines = [f"FEATURE: {channel.name}{unit}   NO. PIECES: {n}", ""]
+    mode = " ".join(signed(m, decimals) for m in d.modes) or "-"
+    lines += _pairs(
+        [
+            ("MAXIMUM", signed(d.max, decimals)),
+            ("AVERAGE", signed(d.mean, decimals)),
+            ("MINIMUM", signed(d.min, decimals)),
+            ("UPPER SPEC", signed(None if limits is None else limits.usl, decimals)),
+            ("NOMINAL", signed(channel.nominal, decimals)),
+            ("LOWER SPEC", signed(None if limits is None else limits.lsl, decimals)),
+            ("TOTAL NUMBER OF PIECES", str(n)),
+            ("SIGMA", signed(d.sd, decimals)),
+            ("RANGE", unsigned(d.range, decimals)),
+        ],
+        width,
+    )
+    skew = "-" if d.skewness is None else f"{d.skewness:+.3f}"
+    lines += _wrap(f"SKEWNESS a1: {skew}   MODE: {mode}", width)
+    for side, count in (("ABOVE UPPER", cap.above_usl), ("BELOW LOWER", cap.below_lsl)):
+        percent = 100.0 * count / n if n else 0.0
+        lines.append(f"PIECES {side} SPEC: {count}   PERCENT {side} SPEC: {percent:.2f}")
+    lines.append("")
+    lines += format_readings(channel.readings, decimals, width)
+    lines.append("")
+    lines.append(f"HISTOGRAM (bin width {channel.histogram.bin_width:g})")
+    lines += format_histogram(channel.histogram, limits, decimals, width, channel.nominal)
+    lines.append("")
+    dispersion = {"I-MR": "MR", "Xbar-R": "R", "Xbar-S": "S"}.get(chart.type, "dispersion")
+    location = "X" if chart.type == "I-MR" else "Xbar"
+    lines.append(
+        f"CONTROL CHART: {chart.type}, subgroup {chart.subgroup}, "
+        f"sigma within {unsigned(chart.sigma_within, decimals)}"
+    )
+    for label, limits_of in ((location, chart), (dispersion, chart.dispersion)):
+        lines.append(
+            f"  {label + ' chart:':<11} UCL {signed(limits_of.ucl, decimals)}   "
+            f"CENTER {signed(limits_of.center, decimals)}   LCL {signed(limits_of.lcl, decimals)}"
+        )
+    if chart.message:
+        lines += _wrap(f"  {chart.message}", width)
+    if channel.alarms:
+        lines.append(f"ALARMS (rules: {config.rule_set}):")
+        for alarm in channel.alarms:
+            lines += _wrap(f"{alarm.rule}: {alarm.text}", width, "  ")
+    else:
+        lines.append(f"ALARMS (rules: {config.rule_set}): none")
+    lines.append("")
+    lines += _capability_lines(cap, chart.type, decimals, width)
+    return lines
+
+
+def format_spatial(spatial: Spatial, config: AnalysisConfig, width: int = 80) -> list[str]:
+    """The 3-D block: per-axis offsets, the report's total, ISO 9283 AP and RP."""
+    spread = spatial.l_sd or spatial.total_offset or None
+    decimals = decimals_for(config.resolution, spread)
+    unit = f" {config.unit}" if config.unit else ""
+    cells = [signed(v, decimals) for v in spatial.offset.values()]
+    column = max(len(c) for c in cells) + 3
+    lines = [
+        f"3-D FIGURES (x, y, z; {spatial.n} cycles)",
+        "  " + " " * 26 + "".join(axis.rjust(column) for axis in spatial.offset),
+        "  " + "Offset (average - nominal)".ljust(26) + "".join(c.rjust(column) for c in cells),
+        "  "
+        + "Nominal".ljust(26)
+        + "".join(signed(v, decimals).rjust(column) for v in spatial.nominal.values()),
+        f"  Total offset sqrt(sum of squared offsets) = ISO 9283 APp: "
+        f"{unsigned(spatial.total_offset, decimals)}{unit}",
+        "  ISO 9283 pose accuracy APx, APy, APz: the offsets above",
+        f"  ISO 9283 pose repeatability RP = l-bar + 3 S_l: "
+        f"{unsigned(spatial.rp, decimals)}{unit} "
+        f"(l-bar {unsigned(spatial.l_mean, decimals)}, S_l {unsigned(spatial.l_sd, decimals)})",
+    ]
+    if spatial.message:
+        lines.append(f"  {spatial.message}")
+    return [wrapped for line in lines for wrapped in _wrap(line, width)]
+
+
+def format_report(
+    analysis: Analysis,
+    title: str = "BASIC STATISTICS COMPREHENSIVE REPORT",
+    width: int = 80,
+    notes: Sequence[str] = (),
+    sections: Sequence[Sequence[str]] = (),
+) -> str:
+    """The whole text report: every channel, the 3-D figures and the hints; ends with a newline.
+
+    ``notes`` are printed under the title (robot, operator, the session's last hash, ...).
+    ``sections`` are blocks of lines (e.g. :func:`format_linearity`, :func:`format_accuracy`)
+    printed after the 3-D figures, before the hints.
+    """
+    config = analysis.config
+    rule = "=" * width
+    lines = _wrap(title, width) + [rule]
+    lines.append(
+        f"Unit: {config.unit or 'not given'}   Resolution: {config.resolution or 'not given'}   "
+        f"Subgroup: {config.subgroup}"
+    )
+    lines.append(f"Run rules: {config.rule_set}   Capable when Cpk >= {config.threshold:g}")
+    for note in notes:
+        lines += _wrap(note, width)
+    if analysis.excluded_cycles:
+        excluded = ", ".join(str(c) for c in analysis.excluded_cycles)
+        lines += _wrap(f"Excluded (rejected) cycles: {excluded}", width)
+    for channel in analysis.channels.values():
+        lines += ["", "-" * width]
+        lines += format_channel(channel, config, width)
+    if analysis.spatial is not None:
+        lines += ["", "-" * width]
+        lines += format_spatial(analysis.spatial, config, width)
+    for section in sections:
+        lines += ["", "-" * width, *section]
+    lines += ["", "-" * width, "HINTS"]
+    if analysis.hints:
+        for hint in analysis.hints:
+            lines += _wrap(f"- {hint}", width)
+    else:
+        lines.append("- none: no skew, offset, shift, alarm or gauge problem stands out.")
+    return "\n".join(line.rstrip() for line in lines) + "\n"
+
+
+def _table(header: Sequence[str], rows: Sequence[Sequence[str]], width: int) -> list[str]:
+    """Right-aligned columns, each as wide as its widest cell, two spaces apart."""
+    widths = [max(len(str(row[j])) for row in [header, *rows]) for j in range(len(header))]
+    lines = []
+    for row in [header, *rows]:
+        line = "  ".join(str(cell).rjust(widths[j]) for j, cell in enumerate(row))
+        lines.append(line[:width].rstrip())
+    return lines
+
+
+def format_linearity(
+    result: LinearityAnalysis, config: AnalysisConfig, width: int = 80
+) -> list[str]:
+    """The linearity block (§2.9): straightness per stroke (LS and MZ of each indicator), per
+    direction, the largest, and the path repeatability along the bar. The judged per-stroke
+    straightness (chart, alarms, capability) is a channel block of its own
+    (:func:`format_channel` of :func:`~station.analysis.linearity.linearity_summary`)."""
+    channels = result.channels
+    spread = max((result.mz[c] for c in channels), default=0.0) or None
+    decimals = decimals_for(config.resolution, spread)
+    unit = f" {config.unit}" if config.unit else ""
+    tolerance = "not given" if result.tolerance is None else f"{result.tolerance:g}{unit}"
+    lines = _wrap(
+        f"LINEARITY (report §2.9; {len(result.strokes)} strokes; straightness tolerance "
+        f"{tolerance})",
+        width,
+    ) + [
+        "  LS: peak-to-valley about the least-squares line; MZ: minimum zone (ISO 1101);",
+        "  both measured along the indicator axis.",
+        "",
+    ]
+    header = ["STROKE", "DIR", "POINTS"] + [
+        f"{c} {kind}" for c in channels for kind in ("LS", "MZ")
+    ]
+    rows = [
+        [str(r.number), r.direction, str(r.points)]
+        + [
+            unsigned(getattr(r.straightness[c], kind), decimals)
+            for c in channels
+            for kind in ("ls", "mz")
+        ]
+        for r in result.strokes
+    ]
+    lines += _table(header, rows, width)
+    lines.append("")
+    rows = [
+        [d.direction, str(d.strokes)]
+        + [
+            f"{unsigned(d.mz_max[c], decimals)} / {unsigned(d.mz_mean[c], decimals)}"
+            for c in channels
+        ]
+        for d in result.directions.values()
+    ]
+    lines.append("PER DIRECTION: MZ straightness, largest / mean")
+    lines += _table(["DIR", "STROKES"] + list(channels), rows, width)
+    lines.append("")
+    for c in channels:
+        path = result.path[c]
+        at = "" if path.at is None else f" at s = {path.at:.{max(decimals - 2, 1)}f}"
+        lines += _wrap(
+            f"{c}: largest straightness LS {unsigned(result.ls[c], decimals)}, MZ "
+            f"{unsigned(result.mz[c], decimals)}{unit}; path repeatability (largest 3s along "
+            f"the bar over {path.strokes} strokes) {unsigned(path.max_3s, decimals)}{unit}{at}",
+            width,
+        )
+    lines += _wrap(
+        "The straightness per stroke is judged above, one reading per stroke: its control "
+        "chart, alarms and capability against the tolerance (one-sided: USL = tolerance).",
+        width,
+    )
+    return lines
+
+
+def format_accuracy(result: AccuracyAnalysis, config: AnalysisConfig, width: int = 80) -> list[str]:
+    """The relative-accuracy block (§2.8): per placement the pendant coordinates, the distance
+    moved and the mean error per axis and in 3-D; across placements the average accuracy per
+    axis, its spread, and the error per unit moved."""
+    spread = max(abs(v) for p in result.placements for v in p.mean.values()) or None
+    decimals = decimals_for(config.resolution, spread)
+    unit = f" {config.unit}" if config.unit else ""
+    lines = _wrap(
+        f"RELATIVE ACCURACY (report §2.8; {len(result.placements)} placements, "
+        f"{result.error_3d.descriptive.n} readings)",
+        width,
+    ) + [
+        "  Error: the first fixture's indicators after the inverse move.",
+        "",
+    ]
+    header = ["PLACE", "N", "PENDANT X, Y, Z", "DIST", "x", "y", "z", "3-D"]
+    rows = []
+    for p in result.placements:
+        pendant = "-" if p.pendant is None else ", ".join(f"{v:.1f}" for v in p.pendant)
+        distance = "-" if p.distance is None else f"{p.distance:.1f}"
+        rows.append(
+            [str(p.number), str(p.n), pendant, distance]
+            + [signed(p.mean[axis], decimals) for axis in ("x", "y", "z")]
+            + [unsigned(p.error_3d, decimals)]
+        )
+    lines += _table(header, rows, width)
+    lines += ["", "ACROSS PLACEMENTS (overall average accuracy in the direction of each axis)"]
+    rows = [
+        [
+            axis,
+            signed(result.average[axis], decimals),
+            unsigned(result.spread[axis], decimals),
+            unsigned(result.span[axis], decimals),
+            "-" if result.scale_error is None else f"{result.scale_error[axis]:+.2e}",
+        ]
+        for axis in ("x", "y", "z")
+    ]
+    lines += _table(["AXIS", "AVERAGE", "SIGMA", "RANGE", "ERROR/UNIT MOVED"], rows, width)
+    d = result.error_3d.descriptive
+    lines += _wrap(
+        f"3-D error sqrt(x^2 + y^2 + z^2) per reading: mean {unsigned(d.mean, decimals)}, "
+        f"sigma {unsigned(d.sd, decimals)}, max {unsigned(d.max, decimals)}{unit}",
+        width,
+    )
+    if result.per_unit is None:
+        lines += _wrap(
+            "Error per unit moved: needs the pendant coordinates of 3 or more placements.", width
+        )
+    return lines

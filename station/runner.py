@@ -1,0 +1,1435 @@
+"""The procedure runner: one state machine that turns a procedure's steps, the operator's actions
+and the instruments' readings into session events.
+
+The TUI and ``station capture`` both drive a :class:`Runner`; nothing about how a step behaves
+lives anywhere else. The runner never imports a UI. Its rules:
+
+* A step is *done* when its ``step`` event is on disk. ``check`` steps are done by
+  :meth:`Runner.confirm`; ``input`` steps by :meth:`Runner.submit_input` (an ``input`` event, then
+  the ``step`` event); ``zero`` steps by :meth:`Runner.zero`; a ``capture`` step by one recorded
+  reading set; a ``cycles`` step by :meth:`Runner.confirm` once at least the procedure's minimum
+  of accepted cycles is recorded (``station capture`` confirms when the target is reached); a
+  ``stroke`` step by :meth:`Runner.confirm` once its minimum of strokes is streamed
+  (:meth:`Runner.stroke` until :meth:`Runner.end_stroke`, points in ``samples`` events). A
+  ``repeat`` block is unrolled into its steps once per placement.
+* A cycle is recorded only when every channel the step needs has a fresh reading from this
+  trigger. A missing, stale or duplicated channel is an operator message and nothing is written.
+* *Acknowledged* means: the ``reading`` event is fsynced (the journal's ``append`` returns only
+  then). :meth:`Runner.capture` returns, and the listener is called, after that.
+* Cycles are numbered 1, 2, ... over the whole session; a rejected cycle keeps its number (readings
+  are never deleted), a resumed session continues the numbering.
+* Alarms of the live analysis are written as ``alarm`` events when they first appear.
+
+Threads: every public method may be called from any thread. A lock serialises journal writes
+and state changes; blocking waits on the instruments happen outside it, so :meth:`interrupt`
+(from a signal handler's thread) never waits for a capture timeout. With the ``push`` trigger,
+completed reading sets arrive on the reader's thread and are queued to the runner's own recorder
+thread (so the reader keeps draining the line while the disk syncs); they become cycles while
+the ``cycles`` or ``capture`` step that was current when they arrived still is, the runner is
+not paused, and the step does not have its count yet.
+
+The listener receives a :class:`RunnerNotice` after every event is on disk (and for messages
+that are not in the file), on whichever thread produced it; it must not block. Alarms: the live
+update's alarms are written as each cycle arrives; the full analysis' alarms (which can flag
+an earlier pattern once the limits have moved) at the end of every capture/cycles step and
+before the finish. An alarm is new unless it flags a cycle an alarm of the same rule and
+channel already flagged (a run growing by a point is one alarm).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import queue
+import socket
+import threading
+import time
+from collections import deque
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+from station.errors import StationError
+from station.instruments.base import SerialSettings
+
+if TYPE_CHECKING:
+    from station.analysis.summary import Analysis
+    from station.procedures import Procedure, Step
+
+Trigger = Literal["poll", "push", "stable"]
+TRIGGERS: tuple[str, ...] = ("poll", "push", "stable")
+
+StepMark = Literal["done", "current", "pending"]
+
+RunnerStatus = Literal["running", "paused", "finished", "interrupted", "failed"]
+"""``running`` (steps or cycles to do), ``paused`` (captures refused until resumed),
+``finished`` (a ``finish`` event is written), ``interrupted`` (an ``interrupted`` event is written;
+the file stays resumable), ``failed`` (a write failed; the file holds everything acknowledged)."""
+
+MessageLevel = Literal["info", "warning", "error"]
+
+CAPTURE_BY = "station capture"
+"""The ``by`` recorded when the headless command confirms a step itself."""
+
+_MESSAGES_KEPT = 20
+
+
+@dataclass(frozen=True)
+class PortSetup:
+    """One serial line: where it is, what it speaks, and which station channel each device
+    channel feeds (``{"1": "x", "2": "y", "3": "z"}``). ``settings`` ``None`` means the
+    protocol's own line settings."""
+
+    url: str
+    protocol: str
+    channel_map: Mapping[str, str]
+    settings: SerialSettings | None = None
+
+    def resolved_settings(self) -> SerialSettings:
+        """The line settings in force: the given ones, else the protocol's."""
+        from station.instruments.protocols import get_protocol
+
+        return self.settings or get_protocol(self.protocol).settings
+
+    def header(self) -> dict[str, Any]:
+        """The port as it is recorded in the session header's ``instruments``."""
+        return {
+            "url": self.url,
+            "protocol": self.protocol,
+            "map": dict(self.channel_map),
+            "settings": self.resolved_settings().as_kwargs(),
+        }
+
+    @classmethod
+    def from_header(cls, recorded: Mapping[str, Any]) -> PortSetup:
+        """The port a session header recorded (for resuming on the same line)."""
+        settings = recorded.get("settings")
+        return cls(
+            url=str(recorded["url"]),
+            protocol=str(recorded["protocol"]),
+            channel_map={str(k): str(v) for k, v in dict(recorded.get("map") or {}).items()},
+            settings=SerialSettings(**settings) if settings else None,
+        )
+
+
+@dataclass(frozen=True)
+class SessionSetup:
+    """What the set-up screen or the ``station capture`` flags collect before a session starts.
+
+    ``None`` for ``unit``, ``resolution``, ``limits`` or ``cycles`` means the procedure's own
+    value. Construction validates and raises :class:`StationError` with a sentence naming the
+    field, so a set-up screen can show it next to the field.
+    """
+
+    procedure: Procedure
+    robot: str
+    operator: str
+    ports: tuple[PortSetup, ...]
+    trigger: Trigger = "poll"
+    unit: str | None = None
+    resolution: float | None = None
+    limits: Mapping[str, Any] | None = None
+    """Per channel a :class:`station.analysis.capability.SpecLimits` (or anything with ``lsl``,
+    ``usl`` and ``nominal``)."""
+    cycles: int | None = None
+    rule_set: str = "report"
+    threshold: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not self.robot.strip():
+            raise StationError("the robot name is empty: name the robot under test")
+        if self.trigger not in TRIGGERS:
+            raise StationError(
+                f"unknown trigger {self.trigger!r}: use one of {', '.join(TRIGGERS)}"
+            )
+        if self.cycles is not None and self.cycles < 1:
+            raise StationError(f"cycles must be at least 1, not {self.cycles}")
+        if self.resolution is not None and not (
+            math.isfinite(self.resolution) and self.resolution > 0
+        ):
+            raise StationError(f"the gauge resolution must be positive, not {self.resolution}")
+        if not math.isfinite(self.threshold) or self.threshold <= 0:
+            raise StationError(f"the capability threshold must be positive, not {self.threshold}")
+        unknown = sorted(set(self.limits or {}) - set(self.channels))
+        if unknown:
+            raise StationError(
+                f"limits given for {', '.join(unknown)}, which procedure "
+                f"{self.procedure.id!r} does not measure (its channels: "
+                f"{', '.join(self.channels)})"
+            )
+        if not self.ports:
+            raise StationError("no port given: name the serial port of the indicators")
+        mapped = {ch for port in self.ports for ch in port.channel_map.values()}
+        missing = [ch for ch in self.channels if ch not in mapped]
+        if missing:
+            raise StationError(
+                f"no device channel feeds {', '.join(missing)}: map one with --map, "
+                f"e.g. 1=x,2=y,3=z"
+            )
+
+    @property
+    def channels(self) -> tuple[str, ...]:
+        """The station channels the procedure measures, in its order."""
+        return tuple(self.procedure.channels)
+
+    @property
+    def resolved_unit(self) -> str:
+        """The session's unit: the set-up's, else the procedure's."""
+        return self.unit or self.procedure.unit
+
+    @property
+    def resolved_resolution(self) -> float:
+        """The gauge resolution: the set-up's, else the procedure's."""
+        return float(self.resolution if self.resolution is not None else self.procedure.resolution)
+
+    @property
+    def resolved_cycles(self) -> int:
+        """The number of cycles a ``cycles`` step asks for: the set-up's, else the procedure's
+        target."""
+        return int(self.cycles if self.cycles is not None else self.procedure.cycles_target)
+
+    def resolved_limits(self) -> dict[str, Any]:
+        """Spec limits per channel: the procedure's defaults overridden by the set-up's."""
+        return _procedure_limits(self.procedure) | dict(self.limits or {})
+
+    def header_fields(self) -> dict[str, Any]:
+        """The session header's fields (the journal adds format, session id, created, prev)."""
+        return {
+            "procedure": {
+                "id": self.procedure.id,
+                "version": self.procedure.version,
+                "sha256": self.procedure.sha256,
+            },
+            "robot": self.robot,
+            "operator": self.operator,
+            "host": socket.gethostname(),
+            "unit": self.resolved_unit,
+            "resolution": self.resolved_resolution,
+            "limits": {
+                channel: {"lsl": limits.lsl, "usl": limits.usl, "nominal": limits.nominal}
+                for channel, limits in self.resolved_limits().items()
+            },
+            "channels": list(self.channels),
+            "instruments": {
+                "trigger": self.trigger,
+                "ports": [port.header() for port in self.ports],
+            },
+            "cycles_target": self.resolved_cycles,
+            "rules": self.rule_set,
+            "threshold": self.threshold,
+        }
+
+
+@dataclass(frozen=True)
+class StepView:
+    """One step of the unrolled procedure as the operator sees it."""
+
+    index: int
+    step: Step
+    """The procedure's step (``id``, ``kind``, ``title``, ``text`` and the kind's own fields)."""
+    placement: int | None
+    """1-based placement inside a ``repeat`` block, else ``None``."""
+    mark: StepMark
+
+    @property
+    def id(self) -> str:
+        """The step's id in the procedure."""
+        return self.step.id
+
+    @property
+    def kind(self) -> str:
+        """``check``, ``input``, ``zero``, ``capture``, ``cycles`` or ``stroke``."""
+        return self.step.kind
+
+
+@dataclass(frozen=True)
+class OperatorMessage:
+    """A sentence for the operator (a refused capture, a warning, an acknowledgement)."""
+
+    level: MessageLevel
+    text: str
+
+
+@dataclass(frozen=True)
+class PortState:
+    """What one port is doing: ``connecting``, ``connected`` or ``disconnected``, and how many
+    frames it rejected."""
+
+    url: str
+    status: str
+    rejected_frames: int
+    detail: str = ""
+
+
+@dataclass(frozen=True)
+class CycleRecord:
+    """One recorded reading set (its ``reading`` event is on disk)."""
+
+    cycle: int
+    values: Mapping[str, float]
+    step_id: str
+    placement: int | None
+    rejected: str | None = None
+    """The reason when the cycle was rejected afterwards."""
+
+    def line(self) -> str:
+        """The one-line form ``cycle 7 x=+0.00012 y=-0.00003 z=+0.00001``."""
+        return f"cycle {self.cycle} " + " ".join(
+            f"{channel}={value:+.5f}" for channel, value in self.values.items()
+        )
+
+
+@dataclass(frozen=True)
+class CycleOutcome:
+    """The result of one capture attempt: recorded (the event is on disk) or refused, with the
+    operator's sentence either way."""
+
+    recorded: bool
+    message: str
+    cycle: CycleRecord | None = None
+
+
+@dataclass(frozen=True)
+class StrokeOutcome:
+    """The result of one stroke: how many points were recorded (in ``samples`` events, all on
+    disk) and how many reading sets were skipped because a channel was missing or stale."""
+
+    stroke: int
+    points: int
+    skipped: int
+    message: str
+
+
+@dataclass(frozen=True)
+class RunnerState:
+    """An immutable snapshot of the runner, safe to read from any thread."""
+
+    path: Path
+    status: RunnerStatus
+    steps: tuple[StepView, ...]
+    current: StepView | None
+    """The step to do now; ``None`` once every step is done (the session can be finished)."""
+    cycle: int
+    """Accepted cycles in the current ``cycles`` step (the k of "cycle k of N")."""
+    cycles_target: int
+    """N: the cycles the current (or last) ``cycles`` step asks for."""
+    cycles_min: int
+    placement: int | None
+    """The current placement p of a ``repeat`` block (1-based), else ``None``."""
+    placements: int | None
+    """P: how many placements the current ``repeat`` block has, else ``None``."""
+    cycles: tuple[CycleRecord, ...]
+    """Every recorded cycle of the session, rejected ones included (with their reason)."""
+    instruments: tuple[PortState, ...]
+    messages: tuple[OperatorMessage, ...]
+    """The latest operator messages, oldest first."""
+    last_hash: str
+    alarms: int
+    """How many ``alarm`` events are in the file."""
+    strokes: int = 0
+    """Strokes recorded in the current ``stroke`` step."""
+    strokes_target: int = 0
+    """How many strokes the current ``stroke`` step asks for (0 outside one)."""
+    stroke_points: int = 0
+    """Points streamed so far in the stroke under way (0 when none is)."""
+
+    @property
+    def accepted(self) -> int:
+        """Cycles recorded and not rejected, over the whole session."""
+        return sum(1 for record in self.cycles if record.rejected is None)
+
+    @property
+    def last_cycle(self) -> CycleRecord | None:
+        """The most recent recorded cycle, or ``None``."""
+        return self.cycles[-1] if self.cycles else None
+
+    @property
+    def can_capture(self) -> bool:
+        """True when a capture would be recorded (a capture step is current, not paused)."""
+        return (
+            self.status == "running"
+            and self.current is not None
+            and self.current.kind in ("capture", "cycles")
+        )
+
+    @property
+    def complete(self) -> bool:
+        """True when every step is done."""
+        return self.current is None
+
+
+Listener = Callable[["RunnerNotice"], None]
+
+
+@dataclass(frozen=True)
+class RunnerNotice:
+    """What the listener receives: the event just written (``None`` for a change that is not
+    in the file: instrument status, a refused capture), and the state after it."""
+
+    event: Mapping[str, Any] | None
+    state: RunnerState
+    message: OperatorMessage | None = None
+
+
+# --------------------------------------------------------------------------------------------
+# Set-up helpers shared by the TUI and `station capture`
+
+
+def _procedure_limits(procedure: Procedure) -> dict[str, Any]:
+    from station.analysis.capability import SpecLimits
+
+    return {
+        channel: SpecLimits(lsl=limit.lsl, usl=limit.usl, nominal=limit.nominal)
+        for channel, limit in procedure.limits.items()
+    }
+
+
+def analysis_config(header: Mapping[str, Any]) -> Any:
+    """The :class:`~station.analysis.summary.AnalysisConfig` a session header implies: its
+    limits, resolution, unit, rule set and threshold (single readings, subgroup 1).
+
+    The live analysis of a running session and the batch analysis of its file are both built
+    from this, so the two agree.
+    """
+    from station.analysis.capability import SpecLimits
+    from station.analysis.summary import AnalysisConfig
+
+    channels = list(header.get("channels") or ())
+    limits = {
+        channel: SpecLimits(lsl=spec.get("lsl"), usl=spec.get("usl"), nominal=spec.get("nominal"))
+        for channel, spec in dict(header.get("limits") or {}).items()
+        if channel in channels
+        and isinstance(spec, Mapping)
+        and (spec.get("lsl") is not None or spec.get("usl") is not None)
+    }
+    resolution = header.get("resolution")
+    return AnalysisConfig(
+        limits=limits,
+        resolution=float(resolution) if isinstance(resolution, int | float) else None,
+        unit=str(header.get("unit") or ""),
+        rule_set=str(header.get("rules") or "report"),
+        threshold=float(header.get("threshold") or 1.0),
+    )
+
+
+def setup_from_header(
+    header: Mapping[str, Any],
+    procedure: Procedure,
+    *,
+    ports: Sequence[PortSetup] | None = None,
+) -> SessionSetup:
+    """The set-up a session header records, to resume it. ``ports`` replaces the recorded
+    ports (a USB adapter that came back under another name)."""
+    from station.analysis.capability import SpecLimits
+
+    instruments = dict(header.get("instruments") or {})
+    recorded_ports = tuple(PortSetup.from_header(p) for p in instruments.get("ports") or ())
+    limits = {
+        channel: SpecLimits(lsl=spec.get("lsl"), usl=spec.get("usl"), nominal=spec.get("nominal"))
+        for channel, spec in dict(header.get("limits") or {}).items()
+        if spec.get("lsl") is not None or spec.get("usl") is not None
+    }
+    cycles = header.get("cycles_target")
+    return SessionSetup(
+        procedure=procedure,
+        robot=str(header["robot"]),
+        operator=str(header.get("operator") or ""),
+        ports=tuple(ports) if ports else recorded_ports,
+        trigger=instruments.get("trigger", "poll"),
+        unit=str(header["unit"]),
+        resolution=float(header["resolution"]) if header.get("resolution") else None,
+        limits=limits,
+        cycles=int(cycles) if isinstance(cycles, int) else None,
+        rule_set=str(header.get("rules") or "report"),
+        threshold=float(header.get("threshold") or 1.0),
+    )
+
+
+def open_gauges(
+    setup: SessionSetup,
+    *,
+    backoff: tuple[float, float] | None = None,
+    on_reading: Callable[[Any], object] | None = None,
+    poll_interval: float = 0.1,
+) -> Any:
+    """Build and start the :class:`~station.instruments.gauge.GaugeSet` the set-up describes.
+
+    The runner attaches its own set and status callbacks; ``on_reading`` (every accepted
+    frame, on a reader thread) is for a live display. The caller stops the set when done.
+    """
+    from station.instruments.gauge import DEFAULT_BACKOFF, GaugeSet, PortSpec
+    from station.instruments.protocols import get_protocol
+
+    specs = [
+        PortSpec(
+            url=port.url,
+            protocol=get_protocol(port.protocol),
+            channel_map=dict(port.channel_map),
+            settings=port.settings,
+        )
+        for port in setup.ports
+    ]
+    gauges = GaugeSet(
+        specs,
+        trigger=setup.trigger,
+        unit=setup.resolved_unit,
+        resolution=setup.resolved_resolution,
+        poll_interval=poll_interval,
+        on_reading=on_reading,
+        backoff=backoff or DEFAULT_BACKOFF,
+    )
+    gauges.start()
+    return gauges
+
+
+# --------------------------------------------------------------------------------------------
+# The runner
+
+
+@dataclass(frozen=True)
+class _PlanItem:
+    """One step of the unrolled procedure (a repeat block's steps appear once per placement)."""
+
+    step: Step
+    placement: int | None
+    placements: int | None
+
+    @property
+    def key(self) -> tuple[str, int | None]:
+        return (self.step.id, self.placement)
+
+
+def _unroll(procedure: Procedure) -> tuple[_PlanItem, ...]:
+    items: list[_PlanItem] = []
+    for step in procedure.steps:
+        if step.kind == "repeat":
+            count = int(step.count_target or 1)
+            for placement in range(1, count + 1):
+                items.extend(_PlanItem(inner, placement, count) for inner in step.steps)
+        else:
+            items.append(_PlanItem(step, None, None))
+    return tuple(items)
+
+
+class Runner:
+    """The state machine of one session; build it with :meth:`start` or :meth:`resume`.
+
+    ``gauges`` is a started :class:`~station.instruments.gauge.GaugeSet` (see
+    :func:`open_gauges`); the runner sets its push-set callback and listens to its ports'
+    status, and the caller stops it after :meth:`finish` or :meth:`interrupt`.
+    """
+
+    def __init__(
+        self,
+        setup: SessionSetup,
+        gauges: Any,
+        writer: Any,
+        *,
+        listener: Listener | None = None,
+    ) -> None:
+        self.setup = setup
+        self.gauges = gauges
+        self._writer = writer
+        self._listener = listener
+        self._lock = threading.RLock()
+        self._outcome_ready = threading.Condition(self._lock)
+        self._outcomes = 0
+        self._last_outcome: CycleOutcome | None = None
+        self._plan = _unroll(setup.procedure)
+        self._position = 0
+        self._status: RunnerStatus = "running"
+        self._busy = False
+        self._cycles: list[CycleRecord] = []
+        # Accepted cycles per (step id, placement) and in all: kept as counts so that a state
+        # snapshot costs the same at the 10 000th cycle as at the first.
+        self._accepted_by_step: dict[tuple[str, int | None], int] = {}
+        self._accepted_count = 0
+        self._next_cycle = 1
+        # Strokes recorded per (step id, placement); the stroke under way and its stop signal.
+        self._strokes: dict[tuple[str, int | None], int] = {}
+        self._stroke_points = 0
+        self._stroke_stop = threading.Event()
+        self._messages: deque[OperatorMessage] = deque(maxlen=_MESSAGES_KEPT)
+        self._alarm_count = 0
+        # (channel, rule) -> the cycles recorded alarms flagged: an alarm sharing one of them is
+        # the same pattern continuing (a run growing by a point), not a new one.
+        self._alarm_flagged: dict[tuple[str, str], set[int]] = {}
+        self._port_states: dict[str, str] = {}
+        self.config = analysis_config(writer.snapshot().header)
+        self._live = self._new_live()
+        self._views: tuple[StepView, ...] = ()
+        self._views_position = -1
+        self._last_event: dict[str, Any] | None = None
+
+    # -- construction -------------------------------------------------------------------------
+
+    @classmethod
+    def start(
+        cls,
+        setup: SessionSetup,
+        gauges: Any,
+        sessions_dir: str | Path,
+        *,
+        listener: Listener | None = None,
+    ) -> Runner:
+        """Create the session file (its header is on disk when this returns) and begin at the
+        procedure's first step."""
+        from station.session.journal import SessionWriter
+
+        writer = SessionWriter.create(sessions_dir, setup.header_fields())
+        runner = cls(setup, gauges, writer, listener=listener)
+        runner._attach("when the session started")
+        runner._say("info", f"Session file {writer.path}.")
+        return runner
+
+    @classmethod
+    def resume(
+        cls,
+        path: str | Path,
+        gauges: Any,
+        *,
+        setup: SessionSetup | None = None,
+        procedures_dirs: Sequence[str | Path] = (),
+        listener: Listener | None = None,
+        by: str = "operator",
+    ) -> Runner:
+        """Continue an unfinished session: a torn tail is moved aside, a ``resume`` event is
+        written, the steps already done stay done and cycle numbering continues.
+
+        ``setup`` defaults to :func:`resume_setup` of the file (the recorded ports).
+        """
+        from station.session.journal import SessionWriter
+
+        setup = setup or resume_setup(path, procedures_dirs=procedures_dirs)
+        # The resume event records the line in use now: a USB adapter may have come back under
+        # another name, and the header keeps the one the session began on.
+        instruments = setup.header_fields()["instruments"]
+        writer, session = SessionWriter.resume(path, by=by, instruments=instruments)
+        try:
+            runner = cls(setup, gauges, writer, listener=listener)
+            runner._replay(session)
+        except BaseException:
+            writer.close()  # release the file's lock: the session stays resumable
+            raise
+        # Only now may readings and port changes reach the runner: its state is the file's.
+        runner._attach("when the session resumed")
+        if session.torn is not None:
+            runner._say("warning", session.torn.message)
+        if setup.procedure.sha256 != session.header["procedure"]["sha256"]:
+            runner._say(
+                "warning",
+                f"The procedure file {setup.procedure.path} changed since this session began; "
+                "its steps are followed as they are now.",
+            )
+        runner._say(
+            "info",
+            f"Resumed {writer.path}: {runner._accepted_total()} cycles so far; "
+            f"the next cycle is {runner._next_cycle}.",
+        )
+        runner._notify(None)
+        return runner
+
+    def _replay(self, session: Any) -> None:
+        """Rebuild the state from a session's events (resume)."""
+        with self._lock:
+            for event in session.events:
+                kind = event["type"]
+                if kind == "step" and self._position < len(self._plan):
+                    item = self._plan[self._position]
+                    if item.key == (event["step"], event.get("placement")):
+                        self._position += 1
+                elif kind == "alarm":
+                    self._alarm_count += 1
+                    key = (str(event.get("channel")), str(event.get("rule")))
+                    self._alarm_flagged.setdefault(key, set()).update(event.get("cycles") or ())
+            for number in sorted(session.cycles):
+                cycle = session.cycles[number]
+                self._cycles.append(
+                    CycleRecord(
+                        cycle=number,
+                        values={ch: r.value for ch, r in cycle.readings.items()},
+                        step_id=cycle.step,
+                        placement=cycle.placement,
+                        rejected=session.rejected.get(number),
+                    )
+                )
+            self._next_cycle = session.next_cycle
+            by_seq = {event["seq"]: event for event in session.events}
+            for batch in session.samples:
+                key = (batch.step, by_seq[batch.seq].get("placement"))
+                self._strokes[key] = max(self._strokes.get(key, 0), batch.stroke or 0)
+            self._rebuild_live()
+            self._views = ()
+
+    # -- callbacks from the instruments ---------------------------------------------------------
+
+    def _attach(self, moment: str) -> None:
+        if getattr(self.gauges, "trigger", None) == "push":
+            self._push_sets: queue.SimpleQueue[tuple[int, Any] | None] = queue.SimpleQueue()
+            threading.Thread(
+                target=self._record_push_sets, name="runner push recorder", daemon=True
+            ).start()
+            self.gauges.on_set = self._on_push_set
+        for reader in getattr(self.gauges, "readers", ()):
+            previous = reader.on_status
+            self._port_states[reader.url] = reader.state
+
+            def chained(status: Any, previous: Any = previous) -> None:
+                if previous is not None:
+                    previous(status)
+                self._on_port_status(status)
+
+            reader.on_status = chained
+        with self._lock:
+            # The file says how each line stood when the session (re)started; changes follow.
+            for url, state in self._port_states.items():
+                self._append("instrument", port=url, state=state, message=moment)
+
+    def _on_port_status(self, status: Any) -> None:
+        with self._lock:
+            if status.state == self._port_states.get(status.port):
+                return
+            self._port_states[status.port] = status.state
+            if self._status in ("running", "paused") and status.state in (
+                "connected",
+                "disconnected",
+            ):
+                self._append(
+                    "instrument", port=status.port, state=status.state, message=status.message
+                )
+                level: MessageLevel = "info" if status.state == "connected" else "warning"
+                self._say(level, f"{status.port}: {status.state} ({status.message})")
+
+    def _on_push_set(self, result: Any) -> None:
+        """A completed push set, on the reader's thread: note when it came, hand it over.
+
+        Recording (an fsync, the live figures) happens on the runner's own thread, so the
+        reader keeps draining the line while the disk works."""
+        with self._lock:
+            if self._busy or self._status != "running":
+                return  # a software zero is taking this set, or the session is not running
+            if not self._capture_step():
+                self._say(
+                    "warning",
+                    "A reading set arrived while no capture step is current; it was not recorded.",
+                )
+                return
+            position = self._position
+        self._push_sets.put((position, result))
+
+    def _record_push_sets(self) -> None:
+        """The push recorder thread: records queued sets in order until the runner closes."""
+        while True:
+            queued = self._push_sets.get()
+            if queued is None:
+                return
+            position, result = queued
+            with self._lock:
+                if self._status != "running" or position != self._position:
+                    continue  # the session or the step moved on since the set arrived
+                # A failed write is already the operator's message and the runner's status.
+                with contextlib.suppress(StationError):
+                    self._record(result, by="operator")
+
+    # -- operator actions -----------------------------------------------------------------------
+
+    def confirm(self, by: str = "operator") -> None:
+        """Complete the current step: a ``check``; a ``cycles`` step once its minimum of
+        accepted cycles is recorded; a ``zero`` step zeroes first. StationError otherwise."""
+        with self._lock:
+            item = self._current_item()
+            kind = item.step.kind
+            if kind == "zero":
+                pass  # zero() takes the lock itself, outside this block
+            elif kind == "check":
+                self._complete_step(item, by)
+                return
+            elif kind == "cycles":
+                done = self._step_accepted(item)
+                target, minimum = self._cycle_counts(item)
+                if done < minimum:
+                    raise StationError(
+                        f"only {done} of {target} cycles are recorded; capture at least "
+                        f"{minimum - done} more before going on"
+                    )
+                if done < target:
+                    self._say(
+                        "warning",
+                        f"Going on with {done} cycles, fewer than the {target} asked for.",
+                    )
+                self._complete_step(item, by)
+                return
+            elif kind == "input":
+                raise StationError(
+                    f"step {item.step.title!r} needs values: type "
+                    + ", ".join(f.label for f in item.step.fields)
+                )
+            elif kind == "capture":
+                raise StationError("this step records one reading set: capture it")
+            elif kind == "stroke":
+                done = self._strokes.get(item.key, 0)
+                target, minimum = self._stroke_counts(item)
+                if self._busy:
+                    raise StationError("a stroke is under way: end it first")
+                if done < minimum:
+                    raise StationError(
+                        f"only {done} of {target} strokes are recorded; record at least "
+                        f"{minimum - done} more before going on"
+                    )
+                self._complete_step(item, by)
+                return
+            else:
+                raise StationError(f"{kind} steps cannot be confirmed (step {item.step.title!r})")
+        self.zero(by=by)
+
+    def submit_input(self, values: Mapping[str, str], by: str = "operator") -> None:
+        """Record the current ``input`` step's values and complete it.
+
+        Each field is checked: a required one must not be empty, a number must parse as a
+        finite number; an unknown name is refused. Nothing is written when one is wrong.
+        """
+        with self._lock:
+            item = self._current_item()
+            if item.step.kind != "input":
+                raise StationError(f"step {item.step.title!r} does not take typed values")
+            fields = {f.name: f for f in item.step.fields}
+            unknown = sorted(set(values) - set(fields))
+            if unknown:
+                raise StationError(
+                    f"step {item.step.title!r} has no field {', '.join(unknown)}; its fields: "
+                    + ", ".join(fields)
+                )
+            recorded: dict[str, Any] = {}
+            for name, spec in fields.items():
+                text = str(values.get(name, "")).strip()
+                if not text:
+                    if spec.required:
+                        raise StationError(f"{spec.label} is required: type a value")
+                    continue
+                if spec.type == "number":
+                    try:
+                        number = float(text)
+                    except ValueError:
+                        number = math.nan
+                    if not math.isfinite(number):
+                        unit = f" in {spec.unit}" if spec.unit else ""
+                        raise StationError(f"{spec.label} must be a number{unit}, not {text!r}")
+                    recorded[name] = number
+                else:
+                    recorded[name] = text
+            self._append(
+                "input", step=item.step.id, placement=item.placement, values=recorded, by=by
+            )
+            self._complete_step(item, by)
+
+    def zero(self, by: str = "operator") -> None:
+        """Zero the current ``zero`` step's channels (the device's command, else a software
+        offset from a fresh reading set), record a ``zero`` event and complete the step."""
+        with self._lock:
+            item = self._current_item()
+            if item.step.kind != "zero":
+                raise StationError(f"step {item.step.title!r} is not a zero step")
+            self._claim()
+        try:
+            results = self.gauges.zero(list(item.step.channels))
+        except StationError as error:
+            with self._lock:
+                self._busy = False
+                self._say("error", error.message)
+            raise
+        except BaseException:
+            with self._lock:
+                self._busy = False
+            raise
+        with self._lock:
+            self._busy = False
+            self._ensure_open()
+            self._append(
+                "zero",
+                step=item.step.id,
+                placement=item.placement,
+                channels={
+                    result.channel: {"method": result.method, "offset": result.offset}
+                    for result in results
+                },
+                by=by,
+            )
+            self._complete_step(item, by)
+
+    def capture(self, timeout: float = 5.0, by: str = "operator") -> CycleOutcome:
+        """Take one reading set and record it as the next cycle (blocking: up to ``timeout``).
+
+        With the ``push`` trigger this waits for the device's next set (which the runner
+        records by itself). Returns the outcome; a refused set (a channel missing, stale or
+        duplicated) records nothing and says why. A failed write raises StationError (the
+        file keeps everything acknowledged).
+        """
+        with self._lock:
+            item = self._current_item()
+            if self._status == "paused":
+                raise StationError("capture is paused: resume it first")
+            if item.step.kind not in ("capture", "cycles"):
+                raise StationError(f"step {item.step.title!r} does not capture readings")
+            if self.setup.trigger == "push":
+                seen = self._outcomes
+                if not self._outcome_ready.wait_for(
+                    lambda: self._outcomes != seen or self._status != "running", timeout
+                ):
+                    return self._refuse(
+                        f"No reading set arrived within {timeout:g} s: press DATA on the "
+                        "gauges (or check the cable)."
+                    )
+                if self._status != "running" or self._last_outcome is None:
+                    return self._refuse(f"The session is {self._status}; nothing recorded.")
+                return self._last_outcome
+            self._claim()
+        try:
+            result = self.gauges.capture(timeout)
+        except BaseException:
+            with self._lock:
+                self._busy = False
+            raise
+        with self._lock:
+            self._busy = False
+            return self._record(result, by=by)
+
+    def stroke(
+        self,
+        timeout: float = 1.0,
+        *,
+        batch_seconds: float = 0.25,
+        batch_points: int = 200,
+        by: str = "operator",
+    ) -> StrokeOutcome:
+        """Stream reading sets as points of one stroke until :meth:`end_stroke` (blocking: call
+        it from a worker thread while the robot moves along the bar).
+
+        Each complete set of the step's channels is one point; points are written in ``samples``
+        events (one per ``batch_seconds`` or ``batch_points``, so the fsync cost stays bounded)
+        numbered by stroke. A set with a channel missing or stale is skipped and counted, never
+        filled in. A stroke with no point is not counted.
+        """
+        with self._lock:
+            item = self._current_item()
+            if self._status == "paused":
+                raise StationError("capture is paused: resume it first")
+            if item.step.kind != "stroke":
+                raise StationError(f"step {item.step.title!r} is not a stroke")
+            self._claim()
+            self._stroke_stop.clear()
+            self._stroke_points = 0
+            number = self._strokes.get(item.key, 0) + 1
+        channels = list(item.step.channels)
+        rows: list[list[float]] = []
+        stamps: list[float] = []
+        points = skipped = 0
+        flushed_at = time.monotonic()
+
+        def flush() -> None:
+            nonlocal rows, stamps, flushed_at
+            if rows:
+                with self._lock:
+                    self._ensure_open()
+                    self._append(
+                        "samples",
+                        step=item.step.id,
+                        placement=item.placement,
+                        stroke=number,
+                        channels=channels,
+                        values=rows,
+                        t_mono=stamps,
+                        by=by,
+                    )
+            rows, stamps, flushed_at = [], [], time.monotonic()
+
+        try:
+            while not self._stroke_stop.is_set() and self._status == "running":
+                result = self.gauges.capture(timeout)
+                if _set_problem(result, channels, self.setup.resolved_unit):
+                    skipped += 1
+                    continue
+                rows.append([float(result.readings[ch].value) for ch in channels])
+                stamps.append(max(result.readings[ch].t_mono for ch in channels))
+                points += 1
+                self._stroke_points = points
+                if len(rows) >= batch_points or time.monotonic() - flushed_at >= batch_seconds:
+                    flush()
+            flush()
+        finally:
+            with self._lock:
+                self._busy = False
+                self._stroke_points = 0
+        with self._lock:
+            if points:
+                self._strokes[item.key] = number
+                message = f"Stroke {number}: {points} points recorded"
+            else:
+                message = f"Stroke {number}: no complete reading set; nothing recorded"
+            if skipped:
+                message += f", {skipped} incomplete sets skipped"
+            self._say("info" if points else "warning", message + ".")
+            return StrokeOutcome(number if points else 0, points, skipped, message + ".")
+
+    def end_stroke(self) -> None:
+        """Stop the stroke under way (its last points are written before :meth:`stroke`
+        returns)."""
+        self._stroke_stop.set()
+
+    def reject_last(self, reason: str, by: str = "operator") -> int:
+        """Reject the most recent accepted cycle with ``reason`` (its readings stay in the file,
+        the analysis leaves it out); returns its number."""
+        reason = reason.strip()
+        if not reason:
+            raise StationError("give a reason for rejecting the cycle")
+        with self._lock:
+            self._ensure_open()
+            accepted = [index for index, r in enumerate(self._cycles) if r.rejected is None]
+            if not accepted:
+                raise StationError("there is no recorded cycle to reject")
+            index = accepted[-1]
+            record = self._cycles[index]
+            self._append("reject", cycle=record.cycle, reason=reason, by=by)
+            self._cycles[index] = CycleRecord(
+                record.cycle, record.values, record.step_id, record.placement, reason
+            )
+            self._rebuild_live()
+            self._say("info", f"Cycle {record.cycle} rejected: {reason}.")
+            self._notify(None)
+            return record.cycle
+
+    def note(self, text: str, by: str = "operator") -> None:
+        """Record the operator's note."""
+        text = text.strip()
+        if not text:
+            raise StationError("the note is empty")
+        with self._lock:
+            self._ensure_open()
+            self._append("note", text=text, by=by)
+
+    def pause(self, by: str = "operator") -> None:
+        """Refuse captures until :meth:`resume_capture` (recorded as a note, for the audit)."""
+        with self._lock:
+            self._ensure_open()
+            if self._status == "paused":
+                return
+            self._status = "paused"
+            self._append("note", text="capture paused", by=by, pause=True)
+
+    def resume_capture(self, by: str = "operator") -> None:
+        """Accept captures again after :meth:`pause`."""
+        with self._lock:
+            if self._status != "paused":
+                return
+            self._status = "running"
+            self._append("note", text="capture resumed", by=by, pause=False)
+
+    def finish(self, by: str = "operator") -> Analysis | None:
+        """Write the ``finish`` event, close the file and return the analysis of the accepted
+        cycles (``None`` when there is none). Finishing before every step is done is allowed;
+        the event says so."""
+        with self._lock:
+            self._ensure_open()
+            complete = self._position >= len(self._plan)
+            accepted = self._accepted_total()
+            self._record_snapshot_alarms()
+            self._append(
+                "finish",
+                by=by,
+                complete=complete,
+                accepted=accepted,
+                rejected=sorted(r.cycle for r in self._cycles if r.rejected is not None),
+            )
+            self._status = "finished"
+            if not complete:
+                self._say("warning", "Finished before every step was done.")
+            self._close()
+            self._notify(None)
+            return self.analysis() if accepted else None
+
+    def interrupt(self, reason: str) -> None:
+        """Write an ``interrupted`` event (``reason``: the signal's name, or why) and close the
+        file; the session stays resumable. Safe from any thread; does nothing once closed."""
+        with self._lock:
+            if self._status in ("finished", "interrupted", "failed"):
+                return
+            self._append("interrupted", reason=reason)
+            self._status = "interrupted"
+            self._close()
+            self._outcome_ready.notify_all()
+            self._notify(None)
+
+    def close(self) -> None:
+        """Close the file without a word (the session stays resumable as it is)."""
+        with self._lock:
+            self._close()
+
+    # -- what the UI reads ----------------------------------------------------------------------
+
+    @property
+    def path(self) -> Path:
+        """The session file."""
+        return Path(self._writer.path)
+
+    @property
+    def last_hash(self) -> str:
+        """The sha256 of the file's last line (print it: it anchors the file)."""
+        return str(self._writer.last_hash)
+
+    def analysis(self) -> Analysis:
+        """The analysis of the accepted cycles so far: equal to the batch ``analyze`` of the
+        session file (rejected cycles excluded). StationError before the first cycle."""
+        from dataclasses import replace
+
+        with self._lock:
+            snapshot = self._live.snapshot()
+            rejected = tuple(r.cycle for r in self._cycles if r.rejected is not None)
+            return replace(snapshot, excluded_cycles=rejected)
+
+    def state(self) -> RunnerState:
+        """An immutable snapshot of where the session is."""
+        with self._lock:
+            item = self._plan[self._position] if self._position < len(self._plan) else None
+            cycles_item = item if item is not None and item.step.kind == "cycles" else None
+            if cycles_item is None:
+                cycles_item = next(
+                    (p for p in reversed(self._plan[: self._position]) if p.step.kind == "cycles"),
+                    None,
+                )
+            target, minimum = self._cycle_counts(cycles_item) if cycles_item else (0, 0)
+            stroke_item = item is not None and item.step.kind == "stroke"
+            views = self._step_views()
+            return RunnerState(
+                path=self.path,
+                status=self._status,
+                steps=views,
+                current=views[self._position] if item is not None else None,
+                cycle=self._step_accepted(cycles_item) if cycles_item else 0,
+                cycles_target=target,
+                cycles_min=minimum,
+                placement=item.placement if item is not None else None,
+                placements=item.placements if item is not None else None,
+                cycles=tuple(self._cycles),
+                instruments=self._instrument_states(),
+                messages=tuple(self._messages),
+                last_hash=self.last_hash,
+                alarms=self._alarm_count,
+                strokes=self._strokes.get(item.key, 0) if stroke_item else 0,
+                strokes_target=self._stroke_counts(item)[0] if stroke_item else 0,
+                stroke_points=self._stroke_points,
+            )
+
+    def prompt(self) -> str:
+        """The current step's instruction for the operator (the per-cycle prompt in a
+        ``cycles`` step), or what to do once every step is done."""
+        with self._lock:
+            if self._position >= len(self._plan):
+                return "Every step is done: finish the session."
+            item = self._plan[self._position]
+            if item.step.kind == "cycles" and item.step.prompt:
+                target, _ = self._cycle_counts(item)
+                return item.step.prompt_for(self._step_accepted(item) + 1, target)
+            return item.step.text or item.step.title
+
+    # -- internals ------------------------------------------------------------------------------
+
+    def _new_live(self) -> Any:
+        from station.analysis.live import LiveAnalysis
+
+        return LiveAnalysis(self.config, self.setup.channels)
+
+    def _rebuild_live(self) -> None:
+        self._recount()
+        self._live = self._new_live()
+        for record in self._cycles:
+            if record.rejected is None:
+                self._live.add_set(record.values)
+
+    def _current_item(self) -> _PlanItem:
+        self._ensure_open()
+        if self._position >= len(self._plan):
+            raise StationError("every step is done: finish the session")
+        return self._plan[self._position]
+
+    def _capture_step(self) -> _PlanItem | None:
+        if self._position >= len(self._plan):
+            return None
+        item = self._plan[self._position]
+        return item if item.step.kind in ("capture", "cycles") else None
+
+    def _ensure_open(self) -> None:
+        if self._status in ("finished", "interrupted", "failed"):
+            raise StationError(f"the session is {self._status}: {self.path}")
+
+    def _claim(self) -> None:
+        if self._busy:
+            raise StationError("a capture or zero is already under way: wait for it")
+        self._busy = True
+
+    def _cycle_counts(self, item: _PlanItem) -> tuple[int, int]:
+        """(target, minimum) accepted cycles for a cycles step; the set-up's count applies to
+        steps outside repeat blocks."""
+        step = item.step
+        if step.kind != "cycles":
+            return (1, 1)
+        if item.placement is None:
+            target = self.setup.resolved_cycles
+        else:
+            target = int(step.count_target or 1)
+        return target, min(int(step.count_min or target), target)
+
+    def _stroke_counts(self, item: _PlanItem) -> tuple[int, int]:
+        """(target, minimum) strokes of a stroke step."""
+        target = int(item.step.count_target or 1)
+        return target, min(int(item.step.count_min or target), target)
+
+    def _step_accepted(self, item: _PlanItem) -> int:
+        return self._accepted_by_step.get(item.key, 0)
+
+    def _accepted_total(self) -> int:
+        return self._accepted_count
+
+    def _recount(self) -> None:
+        self._accepted_by_step = {}
+        accepted = [r for r in self._cycles if r.rejected is None]
+        for record in accepted:
+            key = (record.step_id, record.placement)
+            self._accepted_by_step[key] = self._accepted_by_step.get(key, 0) + 1
+        self._accepted_count = len(accepted)
+
+    def _step_views(self) -> tuple[StepView, ...]:
+        if not self._views or self._views_position != self._position:
+            self._views = tuple(
+                StepView(
+                    index=index,
+                    step=item.step,
+                    placement=item.placement,
+                    mark="done"
+                    if index < self._position
+                    else "current"
+                    if index == self._position
+                    else "pending",
+                )
+                for index, item in enumerate(self._plan)
+            )
+            self._views_position = self._position
+        return self._views
+
+    def _instrument_states(self) -> tuple[PortState, ...]:
+        return tuple(
+            PortState(
+                url=reader.url,
+                status=reader.state,
+                rejected_frames=reader.rejected_count,
+                detail=reader.last_message,
+            )
+            for reader in getattr(self.gauges, "readers", ())
+        )
+
+    def _complete_step(self, item: _PlanItem, by: str) -> None:
+        if item.step.kind in ("capture", "cycles"):
+            self._record_snapshot_alarms()
+        self._append(
+            "step",
+            step=item.step.id,
+            placement=item.placement,
+            kind=item.step.kind,
+            action="confirmed",
+            by=by,
+        )
+        self._position += 1
+        self._notify(None)
+
+    def _refuse(self, message: str) -> CycleOutcome:
+        self._say("warning", message)
+        return CycleOutcome(recorded=False, message=message)
+
+    def _record(self, result: Any, by: str) -> CycleOutcome:
+        """Record a reading set as the next cycle if it is whole and fresh. Lock held."""
+        if self._status != "running":
+            return self._refuse(f"The session is {self._status}; the reading set was not recorded.")
+        item = self._capture_step()
+        if item is None:
+            return self._refuse("No capture step is current; the reading set was not recorded.")
+        needed = tuple(item.step.channels)
+        problem = _set_problem(result, needed, self.setup.resolved_unit)
+        target, _ = self._cycle_counts(item)
+        if item.step.kind == "cycles" and self._step_accepted(item) >= target:
+            # The set-up asked for N: more is a change of plan, not a capture.
+            outcome = self._refuse(
+                f"All {target} cycles are recorded; this reading set was not. Go on, or finish."
+            )
+        elif problem:
+            outcome = self._refuse(f"Not recorded: {problem} Capture again.")
+        else:
+            outcome = self._write_cycle(item, {ch: result.readings[ch] for ch in needed}, by)
+        self._last_outcome = outcome
+        self._outcomes += 1
+        self._outcome_ready.notify_all()
+        return outcome
+
+    def _write_cycle(self, item: _PlanItem, readings: Mapping[str, Any], by: str) -> CycleOutcome:
+        number = self._next_cycle
+        event = {
+            "cycle": number,
+            "step": item.step.id,
+            "placement": item.placement,
+            "by": by,
+            "channels": {
+                channel: {
+                    "value": reading.value,
+                    "unit": reading.unit,
+                    "raw_value": reading.device_value,
+                    "zero": reading.zero_offset,
+                    "raw": reading.raw,
+                    "t_wall": reading.t_wall,
+                    "t_mono": reading.t_mono,
+                }
+                for channel, reading in readings.items()
+            },
+        }
+        self._append("reading", notify=False, **event)
+        self._next_cycle = number + 1
+        record = CycleRecord(
+            cycle=number,
+            values={channel: float(r.value) for channel, r in readings.items()},
+            step_id=item.step.id,
+            placement=item.placement,
+        )
+        self._cycles.append(record)
+        self._accepted_by_step[item.key] = self._accepted_by_step.get(item.key, 0) + 1
+        self._accepted_count += 1
+        # Acknowledged: the listener hears of the reading as soon as it is on disk, with the
+        # state that includes it; the live figures and alarms follow.
+        self._notify(self._last_event)
+        self._record_alarms(self._live.add_set(record.values))
+        if item.step.kind == "capture":
+            self._complete_step(item, by)
+        elif item.step.kind == "cycles":
+            target, _ = self._cycle_counts(item)
+            if self._step_accepted(item) == target:
+                self._say("info", f"All {target} cycles are recorded: go on, or finish.")
+        return CycleOutcome(recorded=True, message=record.line(), cycle=record)
+
+    def _record_alarms(self, updates: Mapping[str, Any]) -> None:
+        """Write ``alarm`` events for alarms that first appear.
+
+        The live update's alarms (the windows the new point completes, judged against the
+        limits as they are now; O(1)) are recorded as each cycle arrives. The full analysis
+        (every point against the final limits, which can flag an earlier pattern once the limits
+        have moved) costs O(n) (tens of ms at a few hundred cycles), so it is checked at the end
+        of every capture or cycles step and before the finish, not per cycle.
+        """
+        for channel, update in updates.items():
+            for alarm in update.alarms:
+                self._record_alarm(channel, alarm)
+
+    def _record_snapshot_alarms(self) -> None:
+        if not self._accepted_total():
+            return
+        for channel, result in self._live.snapshot().channels.items():
+            for alarm in sorted(result.alarms, key=lambda a: (max(a.points), a.rule)):
+                self._record_alarm(channel, alarm)
+
+    def _record_alarm(self, channel: str, alarm: Any) -> None:
+        accepted = [r.cycle for r in self._cycles if r.rejected is None and channel in r.values]
+        cycles = [accepted[p - 1] for p in alarm.points if 0 < p <= len(accepted)]
+        if not cycles:
+            return
+        flagged = self._alarm_flagged.setdefault((channel, alarm.rule), set())
+        known = not flagged.isdisjoint(cycles)
+        flagged.update(cycles)
+        if known:
+            return
+        self._append(
+            "alarm",
+            channel=channel,
+            rule=alarm.rule,
+            points=list(alarm.points),
+            cycles=cycles,
+            text=alarm.text,
+        )
+        self._alarm_count += 1
+        self._say("warning", f"{channel}: {alarm.text}")
+
+    def _append(self, event_type: str, *, notify: bool = True, **fields: Any) -> dict[str, Any]:
+        """Write one event (fsynced when this returns). A failed write marks the runner failed
+        and re-raises the journal's sentence."""
+        fields = {k: v for k, v in fields.items() if v is not None}
+        try:
+            event = self._writer.append(event_type, **fields)
+        except StationError as error:
+            if self._writer.closed:
+                self._status = "failed"
+                self._say("error", error.message)
+                self._outcome_ready.notify_all()
+            raise
+        self._last_event = event
+        if notify:
+            self._notify(event)
+        return event
+
+    def _close(self) -> None:
+        self._writer.close()
+        if getattr(self.gauges, "on_set", None) == self._on_push_set:
+            self.gauges.on_set = None
+            self._push_sets.put(None)
+
+    def _say(self, level: MessageLevel, text: str) -> None:
+        message = OperatorMessage(level, text)
+        self._messages.append(message)
+        self._tell(RunnerNotice(None, self.state(), message))
+
+    def _notify(self, event: Mapping[str, Any] | None) -> None:
+        self._tell(RunnerNotice(event, self.state()))
+
+    def _tell(self, notice: RunnerNotice) -> None:
+        if self._listener is None:
+            return
+        try:
+            self._listener(notice)
+        except Exception as error:  # a display's bug must not undo a recorded event
+            self._messages.append(OperatorMessage("error", f"the display failed: {error!r}"))
+
+
+def _set_problem(result: Any, needed: Sequence[str], unit: str) -> str:
+    """Why a reading set cannot be a cycle ('' when it can): a needed channel missing, stale
+    or duplicated, or in another unit than the session's."""
+    problems = []
+    missing = [c for c in needed if c not in result.readings]
+    stale = [c for c in missing if c in result.stale]
+    absent = [c for c in missing if c not in stale]
+    if absent:
+        problems.append("no reading from " + ", ".join(absent))
+    if stale:
+        problems.append("only readings from before the trigger on " + ", ".join(stale))
+    duplicated = [c for c in needed if c in result.duplicated]
+    if duplicated:
+        problems.append("more than one reading from " + ", ".join(duplicated))
+    other_unit = [
+        f"{c} reads in {result.readings[c].unit}"
+        for c in needed
+        if c in result.readings and result.readings[c].unit != unit
+    ]
+    if other_unit:
+        problems.append(", ".join(other_unit) + f" but the session is in {unit}")
+    if missing and result.errors:
+        problems.extend(result.errors)
+    return "; ".join(problems) + "." if problems else ""
+
+
+def resume_setup(
+    path: str | Path,
+    *,
+    procedures_dirs: Sequence[str | Path] = (),
+    ports: Sequence[PortSetup] | None = None,
+) -> SessionSetup:
+    """The set-up of the session in ``path`` (its procedure found by id), to resume it."""
+    from station.procedures import discover_procedures
+    from station.session.model import load_session
+
+    session = load_session(path, recover=False)
+    if session.finished:
+        raise StationError(f"session {path} is finished; start a new session instead")
+    procedure = discover_procedures(procedures_dirs).get(session.procedure_id)
+    return setup_from_header(session.header, procedure, ports=ports)

@@ -1,0 +1,68 @@
+"""Verdict hints: each fires on its condition and names the channel and the figure."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from station.analysis.capability import SpecLimits
+from station.analysis.summary import AnalysisConfig, analyze
+
+LIMITS = SpecLimits(lsl=-0.001, usl=0.001, nominal=0.0)
+
+
+def hints(values, **config) -> tuple[str, ...]:
+    settings = dict(default_limits=LIMITS, resolution=0.0001, unit="in")
+    settings.update(config)
+    return analyze({"x": np.asarray(values, dtype=float)}, AnalysisConfig(**settings)).hints
+
+
+def noise(n=30, sd=1e-4, seed=4):
+    return np.round(np.random.default_rng(seed).normal(0, sd, n), 4)
+
+
+def test_table_2_1_raises_no_hint(table_2_1):
+    assert hints(table_2_1) == ()
+
+
+def test_strong_skew_points_at_the_control_system():
+    values = np.concatenate([np.zeros(20), [0.0001] * 5, [0.0002, 0.0003, 0.0005, 0.0008]])
+    (hint,) = [h for h in hints(values) if "skewness" in h]
+    assert hint.startswith("x: skewness a1 = +")
+    assert "control system" in hint and "right" in hint
+
+
+def test_mild_skew_raises_no_skew_hint(table_2_1):
+    assert not [h for h in hints(table_2_1) if "skewness" in h]
+
+
+def test_a_clear_offset_points_at_inverse_kinematics_or_temperature():
+    values = noise() + 0.0002
+    (hint,) = [h for h in hints(values) if "off nominal" in h]
+    assert hint.startswith(f"x: the average is {values.mean():+.3g} in off nominal")
+    assert "inverse kinematics" in hint and "temperature" in hint
+
+
+def test_an_offset_within_chance_raises_no_hint():
+    values = noise(seed=9)
+    values = values - values.mean() + 0.00001
+    assert not [h for h in hints(values) if "off nominal" in h]
+
+
+def test_cp_met_but_cpk_not_is_a_shift():
+    values = noise(sd=1e-4, seed=1) + 0.0008  # Cp about 3, Cpk below 1
+    (hint,) = [h for h in hints(values) if "shifted" in h]
+    assert "Cp = " in hint and "Cpk = " in hint and hint.startswith("x:")
+
+
+def test_a_rule_alarm_asks_to_look_at_the_pattern():
+    values = noise()
+    values[20] = 0.0009
+    (hint,) = [h for h in hints(values) if "pattern" in h]
+    assert "report-1 at point 21" in hint
+
+
+def test_a_tolerance_under_ten_gauge_steps_means_the_gauge_is_too_coarse():
+    narrow = SpecLimits(lsl=-0.0004, usl=0.0004)
+    (hint,) = [h for h in hints(noise(), default_limits=narrow) if "too coarse" in h]
+    assert "8 gauge steps" in hint and hint.startswith("x:")
+    assert not [h for h in hints(noise()) if "too coarse" in h]

@@ -1,0 +1,142 @@
+"""Benchmark of the analysis: batch, live, and the `manufacturing` package on the same data.
+
+Run on demand (not part of the test suite):
+
+    .venv/bin/python tests/benchmarks/bench_analysis.py
+
+Targets (issue 2): full ``analyze`` of 1,000,000 readings <= 1 s; ``LiveChannel.add`` at
+n = 100,000 <= 1 ms per reading (and not slower than at the start: O(1)); our Ppk plus the
+Nelson run rules on 100,000 readings at least 20x faster than ``manufacturing``'s ``calc_ppk``
+plus its beyond-limits and zone tests (which are the same eight patterns: zone A = 2 of 3
+beyond 2 sigma, zone B = 4 of 5 beyond 1 sigma, zone C = run on one side, trend, mixture,
+stratification, over-control).
+"""
+
+from __future__ import annotations
+
+import logging
+import statistics
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+
+from station.analysis.capability import SpecLimits, capability  # noqa: E402
+from station.analysis.live import LiveChannel  # noqa: E402
+from station.analysis.rules import check_rules  # noqa: E402
+from station.analysis.summary import AnalysisConfig, analyze  # noqa: E402
+
+RESOLUTION = 0.0001
+LIMITS = SpecLimits(lsl=-0.001, usl=0.001, nominal=0.0)
+
+
+def readings(n: int, seed: int = 1990) -> np.ndarray:
+    """Gauge-like readings (inches, 0.0001 steps) with a slow drift so rules have work to do."""
+    rng = np.random.default_rng(seed)
+    drift = 0.0001 * np.sin(np.arange(n) / 5000.0)
+    return np.round((rng.normal(0.0, 0.00025, n) + drift) / RESOLUTION) * RESOLUTION
+
+
+def best_of(repeats: int, action: Callable[[], object]) -> float:
+    """The fastest of ``repeats`` timings, in seconds (the least disturbed by other load)."""
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        action()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def bench_batch() -> None:
+    data = readings(1_000_000)
+    config = AnalysisConfig(default_limits=LIMITS, resolution=RESOLUTION, rule_set="nelson")
+    analyze({"x": data[:1000]}, config)  # warm the caches (chart constants, scipy imports)
+    seconds = best_of(3, lambda: analyze({"x": data}, config))
+    print(f"analyze, 1,000,000 readings (nelson rules): {seconds:.3f} s  (target <= 1 s)")
+
+
+def bench_live() -> None:
+    data = readings(110_000)
+    config = AnalysisConfig(default_limits=LIMITS, resolution=RESOLUTION, rule_set="nelson")
+    live = LiveChannel("x", config)
+    batch = 10_000
+
+    def timed_adds(values: np.ndarray) -> list[float]:
+        times = []
+        for value in values:
+            start = time.perf_counter()
+            live.add(value)
+            times.append(time.perf_counter() - start)
+        return times
+
+    early = timed_adds(data[:batch])
+    for value in data[batch:100_000]:
+        live.add(value)
+    late = timed_adds(data[100_000:])
+    print(
+        f"LiveChannel.add after 100,000 readings: {statistics.median(late) * 1e6:.1f} us median, "
+        f"{statistics.mean(late) * 1e6:.1f} us mean, {max(late) * 1e3:.2f} ms worst "
+        f"(target <= 1 ms)"
+    )
+    ratio = statistics.median(late) / statistics.median(early)
+    print(
+        f"  baseline, the first 10,000 readings: {statistics.median(early) * 1e6:.1f} us median; "
+        f"ratio late/early {ratio:.2f} (about 1 = O(1); medians, robust to other load)"
+    )
+    start = time.perf_counter()
+    live.snapshot()
+    print(
+        f"  snapshot() at 110,000 readings (once per redraw): "
+        f"{(time.perf_counter() - start) * 1e3:.1f} ms"
+    )
+
+
+def bench_against_manufacturing() -> None:
+    import manufacturing
+    import manufacturing.analysis as theirs
+
+    logging.disable(logging.CRITICAL)  # manufacturing logs every check at INFO/WARNING
+    data = readings(100_000)
+    center = float(data.mean())
+    sigma = float(np.mean(np.abs(np.diff(data)))) / 1.128
+    ucl, lcl = center + 3 * sigma, center - 3 * sigma
+
+    def ours() -> None:
+        capability(data, LIMITS)
+        check_rules(data, center, sigma, "nelson")
+
+    def manufacturing_checks() -> None:
+        manufacturing.calc_ppk(data, LIMITS.usl, LIMITS.lsl)
+        theirs.control_beyond_limits(data, ucl, lcl)
+        theirs.control_zone_a(data, ucl, lcl)
+        theirs.control_zone_b(data, ucl, lcl)
+        theirs.control_zone_c(data, ucl, lcl)
+        theirs.control_zone_trend(data)
+        theirs.control_zone_mixture(data, ucl, lcl)
+        theirs.control_zone_stratification(data, ucl, lcl)
+        theirs.control_zone_overcontrol(data, ucl, lcl)
+
+    ours()
+    our_seconds = best_of(5, ours)
+    their_seconds = best_of(1, manufacturing_checks)
+    print(
+        f"Ppk + 8 pattern tests, 100,000 readings: ours {our_seconds * 1e3:.1f} ms, "
+        f"manufacturing {their_seconds * 1e3:.0f} ms, ratio {their_seconds / our_seconds:.0f}x "
+        f"(target >= 20x)"
+    )
+    config = AnalysisConfig(default_limits=LIMITS, resolution=RESOLUTION, rule_set="nelson")
+    full = best_of(3, lambda: analyze({"x": data}, config))
+    print(
+        f"  our whole analyze (statistics, histogram, capability, chart, rules, hints): "
+        f"{full * 1e3:.1f} ms, ratio {their_seconds / full:.0f}x"
+    )
+
+
+if __name__ == "__main__":
+    bench_batch()
+    bench_live()
+    bench_against_manufacturing()

@@ -1,0 +1,332 @@
+"""The runner walking real procedures against the simulator on a real pty: every event lands
+in a session file that verifies, and the live analysis equals the batch analysis of the file."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from station.analysis.summary import analyze, to_json
+from station.errors import StationError
+from station.instruments.protocols import get_protocol
+from station.instruments.simulator import Faults, GaugeSpec, Simulator, fixture_model
+from station.runner import PortSetup, Runner, RunnerNotice, SessionSetup, analysis_config
+from station.session.model import load_session
+from station.session.verify import verify_session
+
+from .conftest import (
+    cycles_only_procedure,
+    every_kind_procedure,
+    make_simulator,
+    setup_for,
+    strokes_procedure,
+)
+
+
+def batch_analysis(path: Path):
+    """What `station analyze` computes from the file: accepted cycles, the header's config."""
+    session = load_session(path, recover=False)
+    return analyze(
+        session.channel_values(),
+        analysis_config(session.header),
+        excluded_cycles=session.excluded_cycles,
+    )
+
+
+def test_repeatability_walk_poll(simulator, gauges_for, tmp_path):
+    setup = setup_for(simulator.url)
+    gauges = gauges_for(setup)
+    notices: list[RunnerNotice] = []
+    on_disk: list[bool] = []
+
+    def listener(notice: RunnerNotice) -> None:
+        notices.append(notice)
+        if notice.event is not None:
+            # Called only once the event is on disk: its line is in the file already.
+            on_disk.append(notice.event["hash"].encode() in Path(runner_path[0]).read_bytes())
+
+    runner_path: list[Path] = []
+    runner = Runner.start(setup, gauges, tmp_path, listener=listener)
+    runner_path.append(runner.path)
+    state = runner.state()
+    assert [view.mark for view in state.steps][:2] == ["current", "pending"]
+    assert state.current is not None and state.current.id == "fixture"
+
+    with pytest.raises(StationError, match="does not capture"):
+        runner.capture(1.0)
+    while runner.state().current.kind == "check":
+        runner.confirm()
+    assert runner.state().current.kind == "zero"
+    runner.confirm()  # a zero step's confirm zeroes
+    runner.confirm()  # teach B
+    state = runner.state()
+    assert state.current.kind == "cycles" and (state.cycle, state.cycles_target) == (0, 30)
+    assert "Cycle 1 of 30" in runner.prompt()
+
+    with pytest.raises(StationError, match="capture at least 25 more"):
+        runner.confirm()
+    outcomes = []
+    while runner.state().cycle < 30:
+        outcome = runner.capture(3.0)
+        assert outcome.recorded, outcome.message
+        outcomes.append(outcome)
+        if outcome.cycle.cycle == 12:
+            assert runner.reject_last("the cube slipped on the end effector") == 12
+            runner.note("re-seated the cube")
+            runner.pause()
+            assert runner.state().status == "paused" and not runner.state().can_capture
+            with pytest.raises(StationError, match="paused"):
+                runner.capture(1.0)
+            runner.resume_capture()
+    state = runner.state()
+    assert state.cycle == 30 and state.accepted == 30 and len(state.cycles) == 31
+    assert [c.cycle for c in state.cycles if c.rejected] == [12]
+    # The live analysis already equals the batch analysis of what is on disk.
+    assert to_json(runner.analysis()) == to_json(batch_analysis(runner.path))
+    extra = runner.capture(3.0)
+    assert not extra.recorded and extra.message.startswith("All 30 cycles are recorded")
+    runner.confirm()
+    assert runner.state().complete
+    analysis = runner.finish()
+
+    assert all(on_disk) and len(on_disk) > 40
+    result = verify_session(runner.path)
+    assert result.ok, result.message
+    assert result.last_hash == runner.last_hash
+    session = load_session(runner.path, recover=False)
+    assert session.status == "finished"
+    assert session.rejected == {12: "the cube slipped on the end effector"}
+    assert session.excluded_cycles == (12,) and len(session.accepted_cycles) == 30
+    assert [n["text"] for n in session.notes] == [
+        "re-seated the cube",
+        "capture paused",
+        "capture resumed",
+    ]
+    assert session.zeroes and set(session.zeroes[0]["channels"]) == {"x", "y", "z"}
+    confirmed_by = {e["step"]: e["by"] for e in session.events if e["type"] == "step"}
+    assert set(confirmed_by) == {s.id for s in setup.procedure.steps}
+    assert analysis.excluded_cycles == (12,)
+    assert to_json(analysis) == to_json(batch_analysis(runner.path))
+    # The recorded values are what the simulator sent, less the software zero.
+    first = session.cycles[1].readings["x"]
+    assert first.value == pytest.approx(first.raw_value - first.zero, abs=1e-12)
+    # Alarms: every rule alarm of the final analysis was written as an alarm event.
+    recorded = {(a["channel"], a["rule"]) for a in session.alarms}
+    final = {(ch, alarm.rule) for ch, c in analysis.channels.items() for alarm in c.alarms}
+    assert final <= recorded
+    with pytest.raises(StationError, match="finished"):
+        runner.capture(1.0)
+
+
+def test_every_step_kind_and_resume(simulator, gauges_for, tmp_path):
+    procedure = every_kind_procedure(tmp_path)
+    setup = setup_for(simulator.url, procedure)
+    gauges = gauges_for(setup)
+    runner = Runner.start(setup, gauges, tmp_path / "sessions")
+    runner.confirm()
+    with pytest.raises(StationError, match="needs values"):
+        runner.confirm()
+    for bad, match in (
+        ({"x": "twelve"}, "Pendant X must be a number in in"),
+        ({"x": ""}, "Pendant X is required"),
+        ({"x": "1", "y": "2"}, "has no field y"),
+    ):
+        with pytest.raises(StationError, match=match):
+            runner.submit_input(bad)
+    runner.submit_input({"x": " 12.5 ", "remark": "pendant in mm mode"})
+    runner.zero()
+    placements = []
+    for _ in range(2):
+        state = runner.state()
+        placements.append((state.placement, state.placements))
+        runner.confirm()
+        outcome = runner.capture(3.0)
+        assert outcome.recorded and set(outcome.cycle.values) == {"x", "y"}
+    assert placements == [(1, 2), (2, 2)]
+    assert runner.state().current.kind == "cycles"
+    runner.capture(3.0)
+    # Interrupted mid-procedure: the file says so and stays resumable.
+    runner.interrupt("SIGTERM")
+    assert runner.state().status == "interrupted"
+    with pytest.raises(StationError, match="interrupted"):
+        runner.capture(1.0)
+    session = load_session(runner.path, recover=False)
+    assert session.status == "interrupted" and session.next_cycle == 4
+    assert session.inputs["pendant"] == {"x": 12.5, "remark": "pendant in mm mode"}
+
+    resumed = Runner.resume(runner.path, gauges, setup=setup)
+    state = resumed.state()
+    assert state.current.id == "cycles" and state.cycle == 1
+    assert [v.mark for v in state.steps].count("done") == 7
+    outcome = resumed.capture(3.0)
+    assert outcome.cycle.cycle == 4  # numbering continues
+    resumed.capture(3.0)
+    resumed.confirm()
+    resumed.finish()
+    session = load_session(runner.path, recover=False)
+    assert [e["type"] for e in session.events].count("resume") == 1
+    assert sorted(session.cycles) == [1, 2, 3, 4, 5]
+    assert session.cycles[1].placement == 1 and session.cycles[2].placement == 2
+    assert verify_session(runner.path).ok
+    with pytest.raises(StationError, match="finished"):
+        Runner.resume(runner.path, gauges, setup=setup)
+
+
+def test_missing_channel_records_nothing(simulator, gauges_for, tmp_path):
+    # Device channel 4 feeds z, and the simulator serves only 1 to 3: z never answers.
+    procedure = cycles_only_procedure(tmp_path)
+    setup = setup_for(simulator.url, procedure, channel_map={"1": "x", "2": "y", "4": "z"})
+    runner = Runner.start(setup, gauges_for(setup), tmp_path)
+    lines_before = runner.path.read_bytes().count(b"\n")
+    outcome = runner.capture(0.5)
+    assert not outcome.recorded
+    assert "no reading from z" in outcome.message
+    assert runner.path.read_bytes().count(b"\n") == lines_before
+    assert runner.state().messages[-1].text == outcome.message
+
+
+def test_duplicated_channel_is_refused(gauges_for, tmp_path):
+    # Every frame is followed by late copies of earlier frames: sets are never clean.
+    sim = make_simulator(faults=Faults(stale_rate=1.0, stale_count=3))
+    sim.start_pty()
+    try:
+        procedure = every_kind_procedure(tmp_path)
+        setup = setup_for(sim.url, procedure)
+        runner = Runner.start(setup, gauges_for(setup), tmp_path / "s")
+        runner.confirm()
+        runner.submit_input({"x": "1"})
+        runner.zero()  # a software zero takes the first fresh reading of each channel
+        runner.confirm()
+        outcomes = [runner.capture(0.5) for _ in range(3)]
+        refused = [o for o in outcomes if not o.recorded]
+        assert refused, [o.message for o in outcomes]
+        assert all("more than one reading" in o.message for o in refused)
+        assert len(load_session(runner.path, recover=False).cycles) == 3 - len(refused)
+    finally:
+        sim.stop()
+
+
+def test_push_trigger_records_sets_without_capture_calls(gauges_for, tmp_path):
+    sim = make_simulator(seed=11)
+    sim.start_pty()
+    try:
+        setup = setup_for(sim.url, cycles=5, trigger="push")
+        gauges = gauges_for(setup)
+        recorded = threading.Event()
+        cycles_seen: list[int] = []
+
+        def listener(notice: RunnerNotice) -> None:
+            if notice.event is not None and notice.event["type"] == "reading":
+                cycles_seen.append(notice.event["cycle"])
+                recorded.set()
+
+        runner = Runner.start(setup, gauges, tmp_path, listener=listener)
+        while runner.state().current.kind == "check":
+            runner.confirm()
+        sim.push(1)  # DATA pressed during a check step: not a cycle
+        time.sleep(0.3)
+        assert cycles_seen == []
+        zeroing = threading.Thread(target=runner.zero)
+        zeroing.start()
+        deadline = time.monotonic() + 5
+        while zeroing.is_alive() and time.monotonic() < deadline:
+            sim.push(1)  # the software zero waits for a set
+            time.sleep(0.05)
+        zeroing.join(5)
+        runner.confirm()
+        assert runner.state().current.kind == "cycles"
+        for expected in range(1, 6):
+            recorded.clear()
+            sim.push(1)
+            assert recorded.wait(5), f"set {expected} was not recorded"
+        sim.push(1)  # a sixth set: the step has its five
+        time.sleep(0.3)
+        assert cycles_seen == [1, 2, 3, 4, 5]
+        assert runner.state().messages[-1].text.startswith("All 5 cycles are recorded")
+        # capture() under push waits for the device's next set and returns its outcome.
+        runner.reject_last("pressed DATA twice")
+        waiter: list = []
+        thread = threading.Thread(target=lambda: waiter.append(runner.capture(5.0)))
+        thread.start()
+        time.sleep(0.2)
+        sim.push(1)
+        thread.join(5)
+        assert waiter and waiter[0].recorded and waiter[0].cycle.cycle == 6
+        runner.confirm()
+        analysis = runner.finish()
+        assert analysis.excluded_cycles == (5,)
+        assert to_json(analysis) == to_json(batch_analysis(runner.path))
+        values = load_session(runner.path).channel_values()
+        assert len(values["x"]) == 5
+    finally:
+        sim.stop()
+
+
+def test_runner_imports_no_ui():
+    """The runner is domain code: importing it (and the capture command) loads no UI."""
+    code = (
+        "import sys, station.runner, station.commands.capture\n"
+        "ui = [m for m in sys.modules if m.split('.')[0] in ('textual', 'plotext')"
+        " or m.startswith('station.tui')]\n"
+        "print(ui)"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0 and done.stdout.strip() == "[]", done.stdout + done.stderr
+
+
+def test_stroke_streams_points_in_batches(gauges_for, tmp_path):
+    model = fixture_model(("h", "v", "s"), gauge=GaugeSpec(resolution=0.001, unit="mm"))
+    sim = Simulator(get_protocol("mitutoyo"), model, seed=5)
+    sim.start_pty()
+    try:
+        procedure = strokes_procedure(tmp_path)
+        setup = SessionSetup(
+            procedure=procedure,
+            robot="KSC-7",
+            operator="tester",
+            ports=(PortSetup(sim.url, "mitutoyo", {"1": "h", "2": "v", "3": "s"}),),
+        )
+        gauges = gauges_for(setup)
+        runner = Runner.start(setup, gauges, tmp_path / "s")
+        with pytest.raises(StationError, match="only 0 of 2 strokes"):
+            runner.confirm()
+        outcomes = []
+        for index in range(2):
+            if index == 1:
+                # Interrupted between strokes: the resumed session knows stroke 1 is done.
+                runner.interrupt("SIGHUP")
+                runner = Runner.resume(runner.path, gauges, setup=setup)
+                assert runner.state().strokes == 1
+            worker = threading.Thread(
+                target=lambda current=runner: outcomes.append(current.stroke(1.0, batch_points=10))
+            )
+            worker.start()
+            deadline = time.monotonic() + 5
+            while runner.state().stroke_points < 30 and time.monotonic() < deadline:
+                time.sleep(0.01)
+            runner.end_stroke()
+            worker.join(5)
+        assert [o.stroke for o in outcomes] == [1, 2]
+        assert runner.state().strokes == 2 and runner.state().strokes_target == 2
+        runner.confirm()
+        runner.finish()
+        session = load_session(runner.path, recover=False)
+        assert {batch.stroke for batch in session.samples} == {1, 2}
+        assert len(session.samples) >= 6  # streamed in fsynced batches of at most 10 points
+        assert all(len(b.values) <= 10 for b in session.samples)
+        for outcome in outcomes:
+            rows = [b for b in session.samples if b.stroke == outcome.stroke]
+            assert sum(len(b.values) for b in rows) == outcome.points >= 30
+            assert all(b.channels == ("h", "v", "s") for b in rows)
+        # The points are the simulator's values, in the order it sent them.
+        first = session.samples[0].as_arrays()["s"]
+        sent = sim.sent_values("s")
+        assert list(first) == pytest.approx(sent[: len(first)], abs=1e-12)
+        assert verify_session(runner.path).ok
+    finally:
+        sim.stop()
