@@ -103,6 +103,12 @@ def _raw_text(frame: bytes) -> str:
     return frame.decode("ascii", errors="backslashreplace")
 
 
+def _without_binary_noise(value: float) -> float:
+    """A zeroed value as the display shows it: 0.0001 - 0.0003 is -0.00019999999999999998 in
+    binary; rounding at 1e-10 (far below any gauge's resolution) gives back -0.0002."""
+    return round(value, 10)
+
+
 class GaugeReader:
     """One port, one thread: frames in, :class:`GaugeReading` / :class:`Rejection` out.
 
@@ -410,7 +416,7 @@ class GaugeReader:
         offset = self._offsets.get(channel, 0.0)
         reading = GaugeReading(
             channel=channel,
-            value=parsed.value - offset,
+            value=_without_binary_noise(parsed.value - offset),
             unit=parsed.unit or self.unit,
             raw=raw,
             t_wall=t_wall,

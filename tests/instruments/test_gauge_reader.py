@@ -332,3 +332,33 @@ def test_stop_returns_promptly_even_while_reading() -> None:
     assert not reader.alive
     assert reader.state == "stopped"
     assert took < 1.0
+
+
+def test_a_software_zero_leaves_the_decimal_the_display_shows() -> None:
+    """0.0001 - 0.0003 is -0.00019999999999999998 in binary; the session must get -0.0002."""
+    import os
+    import tty
+
+    master, slave = os.openpty()
+    tty.setraw(slave)
+    events: queue.Queue = queue.Queue()
+    reader = GaugeReader(
+        os.ttyname(slave), get_protocol("mitutoyo"), {"1": "x"}, events=events, backoff=FAST
+    )
+    try:
+        reader.start()
+        assert reader.wait_connected(3.0)
+        reader.set_zero_offset("x", 0.0003)
+        os.write(master, b"01A+000.0001\r")
+        deadline = time.monotonic() + 3
+        reading = None
+        while reading is None and time.monotonic() < deadline:
+            item = events.get(timeout=3)
+            reading = item if getattr(item, "channel", None) == "x" else None
+    finally:
+        reader.stop()
+        os.close(master)
+        os.close(slave)
+    assert reading is not None
+    assert reading.device_value == 0.0001
+    assert reading.value == -0.0002
