@@ -298,12 +298,13 @@ def format_report(
 
 
 def _table(header: Sequence[str], rows: Sequence[Sequence[str]], width: int) -> list[str]:
-    """Right-aligned columns, each as wide as its widest cell, two spaces apart."""
+    """Right-aligned columns, each as wide as its widest cell, two spaces apart (callers keep
+    tables narrow enough for ``width``; a longer line is wrapped, never cut)."""
     widths = [max(len(str(row[j])) for row in [header, *rows]) for j in range(len(header))]
     lines = []
     for row in [header, *rows]:
         line = "  ".join(str(cell).rjust(widths[j]) for j, cell in enumerate(row))
-        lines.append(line[:width].rstrip())
+        lines += _wrap(line.rstrip(), width)
     return lines
 
 
@@ -385,17 +386,26 @@ def format_accuracy(result: AccuracyAnalysis, config: AnalysisConfig, width: int
         "  Error: the first fixture's indicators after the inverse move.",
         "",
     ]
-    header = ["PLACE", "N", "PENDANT X, Y, Z", "DIST", "x", "y", "z", "3-D"]
-    rows = []
-    for p in result.placements:
-        pendant = "-" if p.pendant is None else ", ".join(f"{v:.1f}" for v in p.pendant)
-        distance = "-" if p.distance is None else f"{p.distance:.1f}"
-        rows.append(
-            [str(p.number), str(p.n), pendant, distance]
-            + [signed(p.mean[axis], decimals) for axis in ("x", "y", "z")]
-            + [unsigned(p.error_3d, decimals)]
-        )
-    lines += _table(header, rows, width)
+    # Two narrow tables rather than one wide one: pendant coordinates in mm run to 7 digits.
+    rows = [
+        [
+            str(p.number),
+            str(p.n),
+            *(["-"] * 3 if p.pendant is None else [f"{v:.3f}" for v in p.pendant]),
+            "-" if p.distance is None else f"{p.distance:.3f}",
+        ]
+        for p in result.placements
+    ]
+    lines.append("PENDANT (second fixture, home at the first) AND DISTANCE MOVED")
+    lines += _table(["PLACE", "N", "X", "Y", "Z", "DISTANCE"], rows, width)
+    rows = [
+        [str(p.number)]
+        + [signed(p.mean[axis], decimals) for axis in ("x", "y", "z")]
+        + [unsigned(p.error_3d, decimals)]
+        for p in result.placements
+    ]
+    lines += ["", "MEAN ERROR PER PLACEMENT (x, y, z and the 3-D error sqrt(x^2 + y^2 + z^2))"]
+    lines += _table(["PLACE", "x", "y", "z", "3-D"], rows, width)
     lines += ["", "ACROSS PLACEMENTS (overall average accuracy in the direction of each axis)"]
     rows = [
         [

@@ -726,6 +726,227 @@ class Simulator:
         return False
 
 
+@dataclass(frozen=True)
+class Placement:
+    """One placement of the two fixtures (1-based ``number``): the teach pendant's X, Y, Z at
+    the second fixture (home at the first), and the straight distance between the fixtures."""
+
+    number: int
+    pendant: tuple[float, float, float]
+
+    @property
+    def distance(self) -> float:
+        """The length of the move between the fixtures: sqrt(X² + Y² + Z²)."""
+        return math.sqrt(sum(c * c for c in self.pendant))
+
+    def pendant_text(self, unit: str = "in") -> str:
+        """What the pendant shows, e.g. ``X=+31.250 Y=-12.004 Z=+20.117 in``."""
+        x, y, z = self.pendant
+        return f"X={x:+.3f} Y={y:+.3f} Z={z:+.3f} {unit}"
+
+
+class TwoFixtureModel(RobotModel):
+    """The relative-accuracy set-up (§2.8): two 3-D fixtures, the robot homed at each in turn.
+
+    At placement p the second fixture sits at the pendant coordinates P (seeded, each axis
+    between ``reach_min`` and ``reach_max`` from the first, either sign). The robot returns
+    from the second fixture by the inverse of P, and the first fixture's indicators read its
+    error: a scale error per axis (``scale``, per unit moved) and a small rotation
+    (``rotation``, radians about x, y, z: the error ω × P), both growing with the distance moved,
+    plus a constant ``bias`` and repeatability ``noise`` (σ) per reading.
+
+    ``captures`` readings are taken per placement; the k-th reading belongs to placement
+    ``k // captures + 1`` unless :attr:`placement` is set (a runner or the autopilot that knows
+    which placement it is at). :meth:`placement_of` gives the pendant display to type in.
+    """
+
+    channels = ("x", "y", "z")
+
+    def __init__(
+        self,
+        *,
+        scale: tuple[float, float, float] = (2.0e-5, -1.5e-5, 1.0e-5),
+        rotation: tuple[float, float, float] = (0.0, 0.0, 5.0e-6),
+        bias: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        noise: float = 0.0002,
+        reach_min: float = 10.0,
+        reach_max: float = 40.0,
+        captures: int = 1,
+        pendant_resolution: float = 0.001,
+        gauge: GaugeSpec = GaugeSpec(0.0001, -0.5, 0.5, "in"),
+        seed: int = 0,
+    ) -> None:
+        if captures < 1:
+            raise StationError(f"captures per placement must be 1 or more, not {captures}.")
+        if not 0 <= reach_min <= reach_max:
+            raise StationError("the fixtures' reach must satisfy 0 <= reach_min <= reach_max.")
+        self.scale = tuple(float(v) for v in scale)
+        self.rotation = tuple(float(v) for v in rotation)
+        self.bias = tuple(float(v) for v in bias)
+        self.noise = float(noise)
+        self.reach = (float(reach_min), float(reach_max))
+        self.captures = int(captures)
+        self.pendant_resolution = float(pendant_resolution)
+        self._gauge = gauge
+        self.seed = seed
+        self.placement: int | None = None
+        """The placement the robot is at now; None: derived from the reading index."""
+
+    def gauge(self, channel: str) -> GaugeSpec:
+        """The indicator on ``channel``."""
+        return self._gauge
+
+    def placement_of(self, number: int) -> Placement:
+        """Placement ``number`` (1-based): where the pendant says the second fixture is."""
+        if number < 1:
+            raise StationError(f"placements are numbered from 1, not {number}.")
+        rng = random.Random(f"placement/{self.seed}/{number}")
+        low, high = self.reach
+        step = self.pendant_resolution
+        coordinates = []
+        for _ in range(3):
+            magnitude = rng.uniform(low, high) * (1.0 if rng.random() < 0.5 else -1.0)
+            coordinates.append(round(round(magnitude / step) * step, 6))
+        return Placement(number, (coordinates[0], coordinates[1], coordinates[2]))
+
+    def systematic_error(self, number: int) -> tuple[float, float, float]:
+        """The error per axis at placement ``number`` without noise: bias + S·P + ω × P."""
+        px, py, pz = self.placement_of(number).pendant
+        wx, wy, wz = self.rotation
+        rotated = (wy * pz - wz * py, wz * px - wx * pz, wx * py - wy * px)
+        return tuple(  # type: ignore[return-value]
+            b + s * p + r
+            for b, s, p, r in zip(self.bias, self.scale, (px, py, pz), rotated, strict=True)
+        )
+
+    def current_placement(self, k: int) -> int:
+        """The placement of the k-th reading."""
+        return self.placement if self.placement is not None else k // self.captures + 1
+
+    def true_value(self, channel: str, k: int, seed: int) -> float:
+        """The indicator's reading before quantisation and clipping."""
+        index = self.channels.index(channel)
+        rng = random.Random(f"{seed}/{index}/{k}")
+        return self.systematic_error(self.current_placement(k))[index] + self.noise * rng.gauss(
+            0.0, 1.0
+        )
+
+    def value(self, channel: str, k: int, seed: int) -> float:
+        """The k-th displayed reading of ``channel``."""
+        return self._gauge.show(self.true_value(channel, k, seed))
+
+
+class BarModel(RobotModel):
+    """The linearity set-up (§2.9): indicators h and v ride along a parallel bar, scale s.
+
+    The robot shuttles A→B→A… over ``length``: each stroke is a dwell of ``dwell`` readings at
+    its start, then ``points`` readings while moving (a smooth start and stop), so the k-th
+    reading of every channel belongs to one instant. The indicators read, at position s
+    (u = s / length):
+
+    * h: the bar's bow in the horizontal plane, a parabola of sagitta ``bow`` (0 at the ends),
+    * v: the bar's sag under its own weight, the simply supported beam's shape of sagitta
+      ``sag``,
+    * both: the robot path's wobble, ``wobble`` (h) / ``wobble_v`` (v) × sin(2π s / ``period``),
+      the misalignment of the bar to the robot's straight line (``tilt_h``, ``tilt_v`` per unit
+      of travel; a straightness fit removes it), a random offset per stroke (σ
+      ``stroke_jitter``: the path does not repeat exactly) and reading noise (σ ``noise``).
+
+    The scale s reads the position with its own resolution and noise ``scale_noise``.
+    """
+
+    channels = ("h", "v", "s")
+
+    def __init__(
+        self,
+        *,
+        length: float = 20.0,
+        points: int = 400,
+        dwell: int = 20,
+        bow: float = 0.0012,
+        sag: float = 0.0006,
+        wobble: float = 0.0004,
+        wobble_v: float = 0.0002,
+        period: float = 5.0,
+        tilt_h: float = 5.0e-5,
+        tilt_v: float = -3.0e-5,
+        stroke_jitter: float = 0.00005,
+        noise: float = 0.00005,
+        scale_noise: float = 0.0,
+        indicator: GaugeSpec = GaugeSpec(0.0001, -0.5, 0.5, "in"),
+        scale: GaugeSpec | None = None,
+    ) -> None:
+        if points < 2 or dwell < 0:
+            raise StationError("a stroke needs at least 2 points and a dwell of 0 or more.")
+        if not length > 0 or not period > 0:
+            raise StationError("the bar's length and the wobble's period must be positive.")
+        self.length = float(length)
+        self.points = int(points)
+        self.dwell = int(dwell)
+        self.bow, self.sag = float(bow), float(sag)
+        self.wobble, self.wobble_v, self.period = float(wobble), float(wobble_v), float(period)
+        self.tilt_h, self.tilt_v = float(tilt_h), float(tilt_v)
+        self.stroke_jitter, self.noise, self.scale_noise = (
+            float(stroke_jitter),
+            float(noise),
+            float(scale_noise),
+        )
+        self._indicator = indicator
+        self._scale = scale or GaugeSpec(indicator.resolution, -1.0, self.length + 1.0, "in")
+
+    @property
+    def readings_per_stroke(self) -> int:
+        """Readings of each channel per stroke (dwell and motion)."""
+        return self.dwell + self.points
+
+    def gauge(self, channel: str) -> GaugeSpec:
+        """The indicator on h and v, the linear scale on s."""
+        return self._scale if channel == "s" else self._indicator
+
+    def stroke_of(self, k: int) -> tuple[int, float]:
+        """The 1-based stroke of the k-th reading and the true position s along the bar."""
+        stroke, i = divmod(k, self.readings_per_stroke)
+        t = 0.0 if i < self.dwell else (i - self.dwell + 1) / self.points
+        u = (1.0 - math.cos(math.pi * t)) / 2.0  # a smooth start and stop
+        fraction = u if stroke % 2 == 0 else 1.0 - u
+        return stroke + 1, fraction * self.length
+
+    def profile(self, channel: str, s: float) -> float:
+        """The systematic reading of h or v at position s (bar shape, wobble, tilt), no noise."""
+        u = s / self.length
+        wave = math.sin(2.0 * math.pi * s / self.period)
+        if channel == "h":
+            return 4.0 * self.bow * u * (1.0 - u) + self.wobble * wave + self.tilt_h * s
+        if channel == "v":
+            beam = 16.0 / 5.0 * (u - 2.0 * u**3 + u**4)
+            return self.sag * beam + self.wobble_v * wave + self.tilt_v * s
+        raise StationError(f"the bar model has no indicator {channel!r}.")
+
+    def true_value(self, channel: str, k: int, seed: int) -> float:
+        """The reading before quantisation and clipping."""
+        stroke, s = self.stroke_of(k)
+        index = self.channels.index(channel)
+        rng = random.Random(f"{seed}/{index}/{k}")
+        if channel == "s":
+            return s + self.scale_noise * rng.gauss(0.0, 1.0)
+        jitter = random.Random(f"{seed}/{index}/stroke/{stroke}").gauss(0.0, 1.0)
+        return (
+            self.profile(channel, s)
+            + self.stroke_jitter * jitter
+            + self.noise * rng.gauss(0.0, 1.0)
+        )
+
+    def value(self, channel: str, k: int, seed: int) -> float:
+        """The k-th displayed reading of ``channel``."""
+        return self.gauge(channel).show(self.true_value(channel, k, seed))
+
+    def stream(self, strokes: int, seed: int = 0) -> dict[str, list[float]]:
+        """The displayed readings of ``strokes`` whole strokes plus a final dwell, per channel
+        (what a capture would record from the server, without the server)."""
+        count = strokes * self.readings_per_stroke + self.dwell
+        return {c: [self.value(c, k, seed) for k in range(count)] for c in self.channels}
+
+
 def fixture_model(
     channels: Sequence[str],
     *,
@@ -773,6 +994,7 @@ def demo_model(channels: Sequence[str] = ("x", "y", "z"), unit: str = "in") -> F
 
 __all__ = [
     "AxisModel",
+    "BarModel",
     "Faults",
     "FixtureModel",
     "GaugeSpec",
@@ -782,4 +1004,6 @@ __all__ = [
     "SentFrame",
     "Simulator",
     "fixture_model",
+    "Placement",
+    "TwoFixtureModel",
 ]
