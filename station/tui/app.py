@@ -1,0 +1,360 @@
+"""StationApp: the terminal user interface that drives one procedure runner from set-up to verdict.
+
+The app owns the long-lived things: the sessions folder, the procedure catalogue, the open
+instruments and the :class:`~station.runner.Runner`. Screens ask the app to start, resume or end a
+session and receive the runner's state to draw. The runner's listener runs on whatever thread
+wrote the event; it only stores the newest state and posts a coalescing :class:`RunnerChanged`, and
+the app redraws at most ``REDRAW_INTERVAL`` apart on the UI thread (a burst of readings costs one
+redraw, and a reading after a quiet spell is drawn at once).
+
+SIGHUP and SIGTERM (an SSH drop, a shutdown) interrupt the runner, which writes ``interrupted`` to
+the session file, then the app exits and restores the terminal; the next ``station`` offers to
+resume the session. Textual installs no handler for these itself.
+
+Only the home screen is imported at start; the other screens (and numpy, scipy behind the
+analysis) load when first needed, so the first screen appears fast.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import signal
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from textual.app import App
+from textual.binding import Binding
+
+from station.errors import StationError
+from station.tui.messages import RunnerChanged
+
+if TYPE_CHECKING:
+    from station.procedures import ProcedureCatalog
+    from station.runner import Runner, RunnerNotice, RunnerState, SessionSetup
+
+REDRAW_INTERVAL = 0.1
+"""Seconds between two redraws of the live screens: at most ~10 a second, whatever the rate."""
+
+HANGUP_EXIT_CODES = {signal.SIGHUP: 129, signal.SIGTERM: 143}
+
+PORT_OPEN_TIMEOUT = 3.0
+"""Seconds the set-up waits for the gauges' port to open before it refuses to start."""
+
+
+class PortNotOpen(StationError):
+    """The gauges' port did not open at start: nothing was written; the set-up says why."""
+
+
+@dataclass(frozen=True)
+class DemoPort:
+    """The simulated indicators ``station demo`` started, to pre-fill the set-up."""
+
+    url: str
+    protocol: str
+    channel_map: dict[str, str]
+    procedure: str = "repeatability"
+    robot: str = "demo-robot"
+    description: str = "simulated dial indicators (seeded)"
+
+
+@dataclass(frozen=True)
+class StationConfig:
+    """What the command line decided before the app starts."""
+
+    sessions_dir: Path
+    sessions_reason: str
+    """Why this folder (``--sessions``, ``STATION_SESSIONS``, ``./sessions``, the data folder)."""
+    procedure_dirs: tuple[Path, ...] = ()
+    demo: DemoPort | None = None
+    autopilot: bool = False
+    autopilot_pace: float = 0.2
+    """Seconds between two autopilot actions (a cycle every ``autopilot_pace`` seconds)."""
+    capture_timeout: float = 5.0
+    """Seconds a capture waits for every gauge before it is refused."""
+
+
+class StationApp(App[int]):
+    """The station's TUI. ``run()`` returns the exit code (129/143 after SIGHUP/SIGTERM)."""
+
+    CSS_PATH = Path(__file__).with_name("station.tcss")
+    TITLE = "station"
+    ENABLE_COMMAND_PALETTE = False
+    BINDINGS = [Binding("ctrl+c", "quit_station", "Quit", show=False, priority=True)]
+
+    def __init__(self, config: StationConfig) -> None:
+        super().__init__()
+        self.config = config
+        self.runner: Runner | None = None
+        self.session_header: dict[str, Any] = {}
+        """The running session's header fields (robot, procedure, channels, unit, limits)."""
+        self.gauges: Any = None
+        self._catalog: ProcedureCatalog | None = None
+        self._latest_state: RunnerState | None = None
+        self._state_lock = threading.Lock()
+        self._last_redraw = 0.0
+        self._redraw_pending = False
+        self._oldest_pending = 0.0
+        self.redraw_hooks: list[Callable[[float], None]] = []
+        """Called after each redraw with the oldest pending event's stamp (for the benchmark)."""
+        self._signals_installed: list[int] = []
+        self._warmed_up = False
+
+    # ---------------------------------------------------------------------------------------
+    # Start and stop
+
+    def on_mount(self) -> None:
+        """Install the hang-up handlers and show the home screen (or start the autopilot)."""
+        loop = asyncio.get_running_loop()
+        for signum in (signal.SIGHUP, signal.SIGTERM):
+            try:
+                loop.add_signal_handler(signum, self.hang_up, signum)
+                self._signals_installed.append(signum)
+            except (NotImplementedError, RuntimeError, ValueError):
+                pass  # not the main thread (some test harnesses): nothing to restore then
+        from station.tui.screens.home import HomeScreen
+
+        self.push_screen(HomeScreen())
+        if self.config.autopilot:
+            from station.tui.autopilot import run_autopilot
+
+            self.run_worker(run_autopilot(self), group="autopilot", exclusive=True)
+
+    def on_unmount(self) -> None:
+        """Remove the signal handlers and stop the instruments."""
+        loop = asyncio.get_running_loop()
+        for signum in self._signals_installed:
+            loop.remove_signal_handler(signum)
+        self.close_instruments()
+
+    def hang_up(self, signum: int) -> None:
+        """SIGHUP or SIGTERM: write ``interrupted`` (the session stays resumable), then exit."""
+        name = signal.Signals(signum).name
+        self.interrupt_session(name)
+        self.exit(HANGUP_EXIT_CODES.get(signum, 1))
+
+    def interrupt_session(self, reason: str) -> None:
+        """Leave the running session resumable: the runner writes an ``interrupted`` event."""
+        runner = self.runner
+        if runner is None:
+            return
+        status = runner.state().status
+        if status in ("running", "paused"):
+            try:
+                runner.interrupt(reason)
+            except StationError as error:
+                self.notify(error.message, severity="error")
+        self.close_instruments()
+
+    def close_instruments(self) -> None:
+        """Stop the gauge readers (returns promptly)."""
+        gauges, self.gauges = self.gauges, None
+        if gauges is not None:
+            gauges.stop()
+
+    async def action_quit_station(self) -> None:
+        """Ctrl+C: leave an unfinished session resumable, then quit."""
+        self.interrupt_session("quit")
+        self.exit(0)
+
+    def warm_up_analysis(self) -> None:
+        """Load the analysis (numpy, scipy: about half a second) on a thread, early, so that
+        the first captured cycle is not drawn late. Kept off the start path on purpose."""
+        if not self._warmed_up:
+            self._warmed_up = True
+            self.run_worker(_import_analysis, thread=True, group="warm-up", exit_on_error=False)
+
+    # ---------------------------------------------------------------------------------------
+    # Procedures and sessions
+
+    @property
+    def catalog(self) -> ProcedureCatalog:
+        """The installed procedures (built-in plus ``--procedures`` folders), loaded once."""
+        if self._catalog is None:
+            from station.procedures import discover_procedures
+
+            self._catalog = discover_procedures(self.config.procedure_dirs)
+        return self._catalog
+
+    def start_session(self, setup: SessionSetup) -> None:
+        """Open the instruments and start a new session; raises StationError with a sentence."""
+        from station.runner import Runner
+
+        self.warm_up_analysis()
+        self._open_instruments(setup)
+        try:
+            self.runner = Runner.start(
+                setup, self.gauges, self.config.sessions_dir, listener=self._runner_listener
+            )
+        except BaseException:
+            self.close_instruments()
+            raise
+        self.session_header = setup.header_fields()
+        self._show_runner_screen(self.runner.state())
+
+    def _open_instruments(self, setup: SessionSetup) -> None:
+        """Open the gauges and wait for the line, so a wrong port is refused before a session
+        file exists (PortNotOpen with the reader's own sentence)."""
+        from station.runner import open_gauges
+
+        self.close_instruments()
+        self.gauges = open_gauges(setup)
+        if not self.gauges.wait_connected(PORT_OPEN_TIMEOUT):
+            down = [
+                f"{reader.url}: {reader.last_message or reader.state}"
+                for reader in self.gauges.readers
+                if reader.state != "connected"
+            ]
+            self.close_instruments()
+            raise PortNotOpen(
+                f"the port did not open within {PORT_OPEN_TIMEOUT:g} s ({'; '.join(down)}); "
+                "correct it and press F2 again (F3 tests the line)"
+            )
+
+    def resume_session(self, path: Path, ports: Any) -> None:
+        """Reopen the instruments (``ports``: the line as the set-up screen now says) and
+        continue an unfinished session file."""
+        from station.runner import Runner, resume_setup
+
+        setup = resume_setup(path, procedures_dirs=self.config.procedure_dirs, ports=ports)
+        self.warm_up_analysis()
+        self._open_instruments(setup)
+        try:
+            self.runner = Runner.resume(
+                path, self.gauges, setup=setup, listener=self._runner_listener
+            )
+        except BaseException:
+            self.close_instruments()
+            raise
+        self.session_header = setup.header_fields()
+        self._show_runner_screen(self.runner.state())
+
+    def finish_session(self) -> None:
+        """Close the cycles step when it has its minimum, write ``finish``, show the summary."""
+        runner = self.runner
+        if runner is None:
+            return
+        state = runner.state()
+        if (
+            state.current is not None
+            and state.current.kind == "cycles"
+            and state.cycle >= state.cycles_min
+        ):
+            runner.confirm()
+        analysis = runner.finish()
+        state = runner.state()
+        self.close_instruments()
+        from station.tui.screens.summary import SummaryScreen, SummaryView
+
+        self._replace_run_screen(
+            SummaryScreen(SummaryView.from_live(state, analysis, self.session_header))
+        )
+
+    # ---------------------------------------------------------------------------------------
+    # Runner -> screen
+
+    def _runner_listener(self, notice: RunnerNotice) -> None:
+        """Called on the thread that produced the event: store the state, post a message."""
+        with self._state_lock:
+            self._latest_state = notice.state
+        event_type = str((notice.event or {}).get("type", "")) if notice.event else ""
+        self.post_message(RunnerChanged(event_type=event_type, posted_at=time.monotonic()))
+
+    def on_runner_changed(self, message: RunnerChanged) -> None:
+        """Redraw now if the last redraw is old enough, else once when it is."""
+        if not self._oldest_pending or message.posted_at < self._oldest_pending:
+            self._oldest_pending = message.posted_at
+        if self._redraw_pending:
+            return
+        wait = self._last_redraw + REDRAW_INTERVAL - time.monotonic()
+        if wait <= 0:
+            self.redraw_live()
+        else:
+            self._redraw_pending = True
+            self.set_timer(wait, self.redraw_live)
+
+    def redraw_live(self) -> None:
+        """Hand the newest runner state to the screen showing it; switch screens on step kind."""
+        self._redraw_pending = False
+        self._last_redraw = time.monotonic()
+        oldest, self._oldest_pending = self._oldest_pending, 0.0
+        with self._state_lock:
+            state = self._latest_state
+        if state is None or self.runner is None:
+            return
+        if not self._show_runner_screen(state):
+            screen = self.screen
+            show = getattr(screen, "show_state", None)
+            # A screen still being mounted draws the newest state itself in on_mount.
+            if show is not None and screen.is_mounted:
+                show(state)
+        for hook in self.redraw_hooks:
+            hook(oldest)
+
+    def current_state(self) -> RunnerState | None:
+        """The newest runner state (from the listener, else asked)."""
+        with self._state_lock:
+            state = self._latest_state
+        if state is None and self.runner is not None:
+            state = self.runner.state()
+        return state
+
+    def live_analysis(self) -> Any:
+        """The runner's live analysis, or None before the first accepted cycle."""
+        if self.runner is None:
+            return None
+        try:
+            return self.runner.analysis()
+        except StationError:
+            return None
+
+    def _show_runner_screen(self, state: RunnerState) -> bool:
+        """Put up the checklist or the dashboard for the current step; True when it switched."""
+        from station.tui.screens.checklist import ChecklistScreen
+        from station.tui.screens.dashboard import DashboardScreen
+
+        if state.status in ("finished", "interrupted", "failed"):
+            return False
+        wants_dashboard = state.current is None or state.current.kind in (
+            "capture",
+            "cycles",
+            "stroke",
+        )
+        screen = self.screen
+        if wants_dashboard and not isinstance(screen, DashboardScreen):
+            self._replace_run_screen(DashboardScreen(live=True))
+            return True
+        if not wants_dashboard and not isinstance(screen, ChecklistScreen):
+            self._replace_run_screen(ChecklistScreen())
+            return True
+        return False
+
+    def _replace_run_screen(self, screen: Any) -> None:
+        """Swap the set-up, checklist or dashboard for ``screen`` (modals are closed first)."""
+        from textual.screen import ModalScreen
+
+        while isinstance(self.screen, ModalScreen):
+            self.pop_screen()
+        self.switch_screen(screen)
+
+    def go_home(self) -> None:
+        """Back to a fresh home screen (after a summary or a review)."""
+        from station.tui.screens.home import HomeScreen
+
+        self.runner = None
+        with self._state_lock:
+            self._latest_state = None
+        while len(self.screen_stack) > 2:
+            self.pop_screen()
+        self.switch_screen(HomeScreen())
+
+
+def _import_analysis() -> None:
+    """What the first live analysis would otherwise import on the UI thread."""
+    import scipy.special  # noqa: F401 - capability's confidence bound
+    import scipy.stats  # noqa: F401 - the hints' tests
+
+    import station.analysis.summary  # noqa: F401

@@ -1,0 +1,81 @@
+"""``station demo --autopilot``: walk the procedure by itself, through the operator's own actions.
+
+Each move is what a key would do on the screen in front (Enter on the home screen's first new
+session, F2 on the set-up, Enter on each checklist step, Space for each cycle, ``r`` with a
+reason once, ``f`` at the end), at a watchable pace, and the walk stops on the summary. Nothing
+is faked: the runner, the instruments and the session file are the real ones.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from station.tui.app import StationApp
+
+REJECT_AT_CYCLE = 7
+REJECT_REASON = "autopilot: the robot was bumped during this cycle (a demonstration reject)"
+STEP_PAUSES = 5
+"""A checklist step stays on screen this many paces (1 s at the default pace), to be read."""
+
+
+async def run_autopilot(app: StationApp) -> None:
+    """Drive the screens until the summary is up (or the app exits)."""
+    from station.tui.screens.checklist import ChecklistScreen
+    from station.tui.screens.dashboard import DashboardScreen
+    from station.tui.screens.home import HomeScreen
+    from station.tui.screens.setup import SetupScreen
+    from station.tui.screens.summary import SummaryScreen
+
+    pace = app.config.autopilot_pace
+    step_pause = pace * STEP_PAUSES
+    rejected = False
+    opened = False
+    while app.is_running:
+        await asyncio.sleep(pace)
+        screen = app.screen
+        if isinstance(screen, SummaryScreen):
+            return
+        if isinstance(screen, HomeScreen) and not opened:
+            await asyncio.sleep(step_pause)
+            opened = True
+            screen.action_new()
+        elif isinstance(screen, SetupScreen):
+            await asyncio.sleep(step_pause)
+            if app.screen is screen:
+                screen.action_start()
+        elif isinstance(screen, ChecklistScreen):
+            await asyncio.sleep(step_pause)
+            if app.screen is screen and not screen.busy:
+                _fill_inputs(screen)
+                screen.action_confirm()
+        elif isinstance(screen, DashboardScreen) and screen.live:
+            state = app.current_state()
+            if state is None or screen.busy:
+                continue
+            last = state.last_cycle
+            if (
+                not rejected
+                and last is not None
+                and last.cycle == REJECT_AT_CYCLE
+                and last.rejected is None
+            ):
+                rejected = True
+                screen.action_reject(REJECT_REASON)
+            elif not state.can_capture:
+                if state.complete:
+                    screen.action_finish()
+            elif state.current.kind == "capture" or state.cycle < state.cycles_target:
+                screen.action_capture()
+            else:
+                screen.action_finish()
+
+
+def _fill_inputs(screen: object) -> None:
+    """Type a demo value into empty input fields (a teach pendant would show these)."""
+    from textual.widgets import Input
+
+    for widget in screen.query("#step-inputs Input"):  # type: ignore[attr-defined]
+        if isinstance(widget, Input) and not widget.value:
+            widget.value = "0"

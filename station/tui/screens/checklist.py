@@ -1,0 +1,215 @@
+"""The checklist: the procedure's steps on the left with marks, the current step on the right.
+
+Enter does the step: confirms a check, zeroes the indicators at a zero step, saves the typed
+values at an input step. The runner decides what a step means and writes its event; when a
+capture step becomes current, the app switches to the dashboard.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+from rich.text import Text
+from textual import work
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import Horizontal, Vertical, VerticalScroll
+from textual.screen import Screen
+from textual.widgets import Footer, Input, Label, Static
+
+from station.errors import StationError
+from station.tui.widgets.step_list import StepList
+
+if TYPE_CHECKING:
+    from station.runner import RunnerState, StepView
+    from station.tui.app import StationApp
+
+ENTER_DOES = {
+    "check": "Press Enter when this is done.",
+    "zero": "Keep the robot still, then press Enter to zero the indicators.",
+    "input": "Type the values, then press Enter to save them.",
+}
+
+
+class ChecklistScreen(Screen[None]):
+    """One step at a time, with the whole list in view."""
+
+    BINDINGS = [
+        Binding("enter", "confirm", "Confirm step"),
+        Binding("space", "confirm", "Confirm step", show=False),
+        Binding("n", "note", "Note"),
+        Binding("f1", "help", "Help"),
+        Binding("q", "leave", "Leave (resumable)"),
+    ]
+
+    app: StationApp
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._shown_step: tuple[int, str] | None = None
+        self.busy = False
+        """True while the runner carries out a step (keys for another step wait for it)."""
+
+    def compose(self) -> ComposeResult:
+        """Steps left, the current step right."""
+        yield Static(id="run-title")
+        with Horizontal(id="checklist"):
+            with VerticalScroll(id="steps-box"):
+                yield StepList(id="steps")
+            with Vertical(id="step-panel"):
+                yield Static(id="step-title")
+                yield Static(id="step-text")
+                yield Vertical(id="step-inputs")
+                yield Static(id="step-action")
+                yield Static(id="step-message")
+        yield Footer()
+
+    def on_mount(self) -> None:
+        """Draw the runner's current state."""
+        state = self.app.current_state()
+        if state is not None:
+            self.show_state(state)
+
+    def show_state(self, state: RunnerState) -> None:
+        """Redraw from a runner snapshot (UI thread)."""
+        self.query_one("#run-title", Static).update(_run_title(state))
+        self.query_one(StepList).show(state.steps)
+        current = state.current
+        key = (current.index, current.id) if current is not None else None
+        if key != self._shown_step:
+            self._shown_step = key
+            self._show_step(current)
+        message = state.messages[-1] if state.messages else None
+        if message is not None:
+            style = {"error": "bold red", "warning": "yellow"}.get(message.level, "green")
+            self.query_one("#step-message", Static).update(Text(message.text, style=style))
+
+    def _show_step(self, view: StepView | None) -> None:
+        inputs = self.query_one("#step-inputs", Vertical)
+        inputs.remove_children()
+        if view is None:
+            self.query_one("#step-title", Static).update("Every step is done.")
+            self.query_one("#step-text", Static).update("")
+            self.query_one("#step-action", Static).update("")
+            return
+        step = view.step
+        placement = f" (placement {view.placement})" if view.placement else ""
+        self.query_one("#step-title", Static).update(
+            Text(f"Step {view.index + 1}: {step.title}{placement}", style="bold")
+        )
+        self.query_one("#step-text", Static).update(" ".join(step.text.split()))
+        action = ENTER_DOES.get(step.kind, "Press Enter to continue.")
+        if self.app.config.demo is not None:
+            action += " (Demo: the robot and the gauges are simulated; just press Enter.)"
+        self.query_one("#step-action", Static).update(Text(action, style="bold cyan"))
+        if step.kind == "input":
+            for field in step.fields:
+                unit = f" ({field.unit})" if field.unit else ""
+                row = Horizontal(
+                    Label(f"{field.label}{unit}", classes="field-label"),
+                    Input(
+                        compact=True,
+                        id=f"input-{field.name}",
+                        type="number" if field.type == "number" else "text",
+                    ),
+                    classes="field-row",
+                )
+                inputs.mount(row)
+            self.call_after_refresh(self._focus_first_input)
+
+    def _focus_first_input(self) -> None:
+        for widget in self.query("#step-inputs Input"):
+            widget.focus()
+            return
+
+    # -- actions --------------------------------------------------------------------------
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        """Enter in a field moves to the next one, and saves after the last."""
+        fields = list(self.query("#step-inputs Input"))
+        index = fields.index(event.input) if event.input in fields else len(fields) - 1
+        if index + 1 < len(fields):
+            fields[index + 1].focus()
+        else:
+            self.action_confirm()
+
+    def action_confirm(self) -> None:
+        """Do the current step through the runner (in a worker: zeroing talks to the gauges)."""
+        runner = self.app.runner
+        state = self.app.current_state()
+        if runner is None or state is None or state.current is None or self.busy:
+            return
+        kind = state.current.kind
+        if kind == "input":
+            values = {
+                str(widget.id).removeprefix("input-"): str(widget.value)  # type: ignore[attr-defined]
+                for widget in self.query("#step-inputs Input")
+            }
+            self._do(lambda: runner.submit_input(values))
+        elif kind == "zero":
+            self.query_one("#step-message", Static).update(Text("Zeroing ...", style="yellow"))
+            self._do(runner.zero)
+        else:
+            self._do(runner.confirm)
+
+    def _do(self, call: Callable[[], Any]) -> None:
+        self.busy = True
+        self._run_in_thread(call)
+
+    @work(thread=True, group="runner-action", exit_on_error=False)
+    def _run_in_thread(self, call: Callable[[], Any]) -> None:
+        """Thread worker: the runner's call; a refusal comes back as a sentence."""
+        try:
+            call()
+        except StationError as error:
+            self.app.call_from_thread(self._refused, error.message)
+        finally:
+            self.app.call_from_thread(self._done)
+
+    def _done(self) -> None:
+        self.busy = False
+
+    def _refused(self, sentence: str) -> None:
+        self.query_one("#step-message", Static).update(Text(sentence, style="bold red"))
+
+    def action_note(self) -> None:
+        """A free-text note in the session file."""
+        from station.tui.screens.dialogs import TextPrompt
+
+        def save(text: str | None) -> None:
+            if text and self.app.runner is not None:
+                self._do(lambda: self.app.runner.note(text))  # type: ignore[union-attr]
+
+        self.app.push_screen(TextPrompt("Note", "What should the session file say?"), callback=save)
+
+    def action_help(self) -> None:
+        """The keys."""
+        from station.tui.screens.dialogs import HelpScreen
+
+        self.app.push_screen(HelpScreen())
+
+    def action_leave(self) -> None:
+        """Leave the session unfinished (it is marked interrupted and offered for resume)."""
+        from station.tui.screens.dialogs import ConfirmScreen
+
+        def leave(sure: bool | None) -> None:
+            if sure:
+                self.app.interrupt_session("operator left")
+                self.app.go_home()
+
+        self.app.push_screen(
+            ConfirmScreen(
+                "Leave this session?",
+                "It is kept as interrupted; choose Resume on the home screen to continue.",
+            ),
+            callback=leave,
+        )
+
+
+def _run_title(state: RunnerState) -> Text:
+    """The session file's name, and the status when it is not plainly running."""
+    text = Text(f"Session {state.path.name}", style="bold")
+    if state.status != "running":
+        text.append(f"  [{state.status.upper()}]", style="bold yellow")
+    return text

@@ -1,0 +1,437 @@
+"""The capture dashboard: live statistics for every axis, the charts of the selected one.
+
+At 80×24 three axes side by side do not fit with charts, so the statistics of x, y and z sit in
+one table at the top and the histogram and control chart below show the selected axis (x, y, z
+or Tab to switch). Space captures a cycle in a thread worker (the runner blocks on the gauges,
+never the screen); the app hands this screen the runner's newest state at most ~10 times a
+second. The same screen opens a saved session read-only (review), without the capture keys.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from rich.text import Text
+from textual import work
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import Horizontal
+from textual.screen import Screen
+from textual.widgets import Footer, Static
+
+from station.errors import StationError
+from station.tui.messages import CaptureFinished
+from station.tui.widgets.alarm_log import AlarmLog, alarm_lines
+from station.tui.widgets.control_chart import ControlChartView, chart_data
+from station.tui.widgets.figures import decimals_for
+from station.tui.widgets.histogram import HistogramView, histogram_data
+from station.tui.widgets.instrument_status import InstrumentStatus
+from station.tui.widgets.stats_panel import StatsPanel, StatsRows
+
+if TYPE_CHECKING:
+    from station.runner import RunnerState
+    from station.tui.app import StationApp
+
+
+@dataclass(frozen=True)
+class DashboardView:
+    """Everything the dashboard draws, from a live runner or from a saved session."""
+
+    title: str
+    progress: str
+    prompt: str
+    channels: tuple[str, ...]
+    analyses: Mapping[str, Any] = field(default_factory=dict)
+    last: Mapping[str, float] = field(default_factory=dict)
+    cycle_numbers: tuple[int, ...] = ()
+    """The cycle number of each accepted cycle, in order (the charts' points)."""
+    ports: tuple[Any, ...] = ()
+    message: Any = None
+    """The runner's newest operator message (an ``OperatorMessage``), shown once when new."""
+    resolution: float | None = None
+    unit: str = ""
+    ready_to_finish: bool = False
+
+    @classmethod
+    def from_live(
+        cls, state: RunnerState, analysis: Any, header: Mapping[str, Any]
+    ) -> DashboardView:
+        """From the runner's snapshot, its live analysis (None before the first cycle) and the
+        session header's fields (robot, channels, unit, resolution)."""
+        channels = tuple(header.get("channels") or ()) or tuple(
+            (analysis.channels if analysis is not None else {}).keys()
+        )
+        accepted = [record for record in state.cycles if record.rejected is None]
+        last_cycle = state.last_cycle
+        current = state.current
+        kind = current.kind if current is not None else None
+        rejected = len(state.cycles) - len(accepted)
+        if kind == "cycles":
+            ready = state.cycle >= state.cycles_target
+            progress = f"cycle {state.cycle} of {state.cycles_target}"
+            if state.cycle < state.cycles_min:
+                progress += f" (at least {state.cycles_min})"
+            prompt = current.step.prompt_for(state.cycle + 1, state.cycles_target)
+            prompt = (prompt or current.step.title) + "  Press Space to capture."
+        elif kind == "capture":
+            ready = False
+            progress = f"{len(accepted)} captured"
+            prompt = f"{current.step.title}: {' '.join(current.step.text.split())}"
+            prompt = prompt.rstrip() + "  Press Space to capture."
+        else:
+            ready = True
+            progress = f"{len(accepted)} captured"
+            prompt = ""
+        if state.placement is not None and state.placements:
+            progress = f"placement {state.placement} of {state.placements}, {progress}"
+        if ready:
+            prompt = "Every cycle asked for is captured. Press f to finish and see the verdict."
+        if rejected:
+            progress += f", {rejected} rejected"
+        if state.status == "paused":
+            progress += "  PAUSED"
+            prompt = "Captures are paused. Press p to continue."
+        message = state.messages[-1] if state.messages else None
+        return cls(
+            title=session_title(header),
+            progress=progress,
+            prompt=prompt,
+            channels=channels,
+            analyses=dict(analysis.channels) if analysis is not None else {},
+            last=dict(last_cycle.values) if last_cycle is not None else {},
+            cycle_numbers=tuple(record.cycle for record in accepted),
+            ports=tuple(state.instruments),
+            message=message,
+            resolution=header.get("resolution"),
+            unit=str(header.get("unit", "")),
+            ready_to_finish=ready,
+        )
+
+
+class DashboardScreen(Screen[None]):
+    """Live capture (``live=True``) or a saved session read-only (``view=...``)."""
+
+    BINDINGS = [
+        Binding("space", "capture", "Capture"),
+        Binding("r", "reject", "Reject"),
+        Binding("n", "note", "Note"),
+        Binding("p", "pause", "Pause"),
+        Binding("f", "finish", "Finish"),
+        Binding("tab", "next_axis", "Axis", key_display="xyz"),
+        Binding("x", "axis('x')", "x", show=False),
+        Binding("y", "axis('y')", "y", show=False),
+        Binding("z", "axis('z')", "z", show=False),
+        Binding("f1", "help", "Help"),
+        Binding("question_mark", "help", "Help", show=False),
+        Binding("q", "leave", "Leave"),
+        Binding("escape", "back", "Back", show=False),
+    ]
+    LIVE_ONLY = frozenset({"capture", "reject", "note", "pause", "finish"})
+
+    app: StationApp
+
+    def __init__(self, *, live: bool, view: DashboardView | None = None) -> None:
+        super().__init__()
+        self.live = live
+        self.view = view
+        self.selected = ""
+        self.capturing = False
+        self._action_busy = False
+        self._shown_message: Any = None
+        self._drawn_once = False
+
+    @property
+    def busy(self) -> bool:
+        """True while a capture or another runner call is under way."""
+        return self.capturing or self._action_busy
+
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """Capture keys only when live; Escape only when reviewing."""
+        if action in self.LIVE_ONLY:
+            return self.live
+        if action == "back":
+            return not self.live
+        return True
+
+    def compose(self) -> ComposeResult:
+        """Title and progress, prompt, statistics, charts, alarms, instruments, message."""
+        yield Static(id="dash-title")
+        yield Static(id="dash-prompt")
+        yield StatsPanel(id="dash-stats")
+        with Horizontal(id="dash-charts"):
+            yield HistogramView(id="dash-histogram")
+            yield ControlChartView(id="dash-chart")
+        yield AlarmLog(id="dash-alarms")
+        yield InstrumentStatus(id="dash-instruments")
+        yield Static(id="dash-message")
+        yield Footer()
+
+    def on_mount(self) -> None:
+        """Draw the newest state (live) or the saved session (review)."""
+        if self.live:
+            state = self.app.current_state()
+            if state is not None:
+                self.show_state(state)
+        elif self.view is not None:
+            self.draw(self.view)
+
+    # -- drawing --------------------------------------------------------------------------
+
+    def show_state(self, state: RunnerState) -> None:
+        """Redraw from a runner snapshot and the live analysis (UI thread)."""
+        self.draw(DashboardView.from_live(state, self.app.live_analysis(), self.app.session_header))
+
+    def draw(self, view: DashboardView) -> None:
+        """Put ``view`` on screen."""
+        self.view = view
+        if view.channels and self.selected not in view.channels:
+            self.selected = view.channels[0]
+        decimals = decimals_for(view.resolution)
+        title = Text(view.title, style="bold")
+        title.append(f"   {view.progress}", style="bold cyan")
+        self.query_one("#dash-title", Static).update(title)
+        self.query_one("#dash-prompt", Static).update(
+            Text(view.prompt, style="bold green" if view.ready_to_finish else "")
+        )
+        self.query_one(StatsPanel).show(
+            StatsRows(
+                channels=view.channels,
+                analyses=view.analyses,
+                last=view.last,
+                decimals=decimals,
+                unit=view.unit,
+                selected=self.selected,
+            )
+        )
+        selected = view.analyses.get(self.selected)
+        self.query_one(HistogramView).show(histogram_data(selected, decimals))
+        self.query_one(ControlChartView).show(
+            chart_data(selected, list(view.cycle_numbers), decimals)
+        )
+        self.query_one(AlarmLog).show(alarm_lines(view.analyses, view.cycle_numbers))
+        instruments = self.query_one(InstrumentStatus)
+        if self.live:
+            instruments.show(view.ports)
+        else:
+            instruments.update(Text("recorded session (read-only)", style="dim"))
+        # The message line says the newest news: a capture's outcome (said by this screen) or
+        # a new message of the runner (a reconnect, a refused set); an old one is not repeated.
+        if view.message is not None and view.message is not self._shown_message:
+            self._shown_message = view.message
+            if self._drawn_once:
+                style = {"error": "bold red", "warning": "yellow"}.get(view.message.level, "green")
+                self._say(view.message.text, style)
+        self._drawn_once = True
+
+    def _say(self, text: str, style: str = "") -> None:
+        self.query_one("#dash-message", Static).update(Text(text, style=style))
+
+    def _redraw(self) -> None:
+        if self.view is not None:
+            self.draw(self.view)
+
+    # -- axis -----------------------------------------------------------------------------
+
+    def action_axis(self, channel: str) -> None:
+        """Show this axis in the charts (x, y, z)."""
+        if self.view is not None and channel in self.view.channels:
+            self.selected = channel
+            self._redraw()
+
+    def action_next_axis(self) -> None:
+        """The next axis in the charts."""
+        if self.view is None or not self.view.channels:
+            return
+        channels = list(self.view.channels)
+        index = channels.index(self.selected) if self.selected in channels else -1
+        self.selected = channels[(index + 1) % len(channels)]
+        self._redraw()
+
+    # -- capture --------------------------------------------------------------------------
+
+    def action_capture(self) -> None:
+        """Take one cycle's readings (a thread worker; the screen stays live meanwhile)."""
+        if not self.live or self.capturing or self.app.runner is None:
+            return
+        self.capturing = True
+        self._say("Capturing ...", "yellow")
+        self._capture(self.app.config.capture_timeout)
+
+    @work(thread=True, group="capture", exit_on_error=False)
+    def _capture(self, timeout: float) -> None:
+        """Thread worker: block on the gauges here, never on the UI thread."""
+        runner = self.app.runner
+        try:
+            outcome = runner.capture(timeout) if runner is not None else None
+            self.post_message(CaptureFinished(outcome=outcome))
+        except StationError as error:
+            self.post_message(CaptureFinished(error=error.message))
+
+    def on_capture_finished(self, message: CaptureFinished) -> None:
+        """Say what happened; the drawing follows the runner's notice."""
+        self.capturing = False
+        if message.error:
+            self._say(message.error, "bold red")
+        elif message.outcome is not None:
+            outcome = message.outcome
+            self._say(outcome.message, "green" if outcome.recorded else "bold red")
+
+    def _in_thread(self, call: Callable[[], Any]) -> None:
+        if self._action_busy:
+            return
+        self._action_busy = True
+        self._runner_action(call)
+
+    @work(thread=True, group="runner-action", exit_on_error=False)
+    def _runner_action(self, call: Callable[[], Any]) -> None:
+        """Thread worker for the runner's quick calls (each fsyncs an event)."""
+        try:
+            call()
+        except StationError as error:
+            self.app.call_from_thread(self._say, error.message, "bold red")
+        finally:
+            self.app.call_from_thread(self._action_done)
+
+    def _action_done(self) -> None:
+        self._action_busy = False
+
+    def action_reject(self, reason: str | None = None) -> None:
+        """Reject the last cycle, with a reason (the readings stay in the file)."""
+        state = self.app.current_state()
+        runner = self.app.runner
+        if not self.live or runner is None or state is None:
+            return
+        last = state.last_cycle
+        if last is None or last.rejected is not None:
+            self._say("There is no captured cycle to reject.", "yellow")
+            return
+        if reason is not None:
+            self._in_thread(lambda: runner.reject_last(reason))
+            return
+        from station.tui.screens.dialogs import TextPrompt
+
+        def reject(text: str | None) -> None:
+            if text:
+                self._in_thread(lambda: runner.reject_last(text))
+
+        self.app.push_screen(
+            TextPrompt(
+                f"Reject cycle {last.cycle}",
+                "Why? (e.g. the robot was bumped, the cube slipped). The readings stay in "
+                "the file, marked rejected, and are left out of the analysis.",
+            ),
+            callback=reject,
+        )
+
+    def action_note(self) -> None:
+        """A free-text note in the session file."""
+        runner = self.app.runner
+        if not self.live or runner is None:
+            return
+        from station.tui.screens.dialogs import TextPrompt
+
+        def save(text: str | None) -> None:
+            if text:
+                self._in_thread(lambda: runner.note(text))
+
+        self.app.push_screen(TextPrompt("Note", "What should the session file say?"), callback=save)
+
+    def action_pause(self) -> None:
+        """Pause captures (e.g. while the cell is entered), or continue."""
+        runner = self.app.runner
+        state = self.app.current_state()
+        if not self.live or runner is None or state is None:
+            return
+        if state.status == "paused":
+            self._in_thread(runner.resume_capture)
+        else:
+            self._in_thread(runner.pause)
+
+    def action_finish(self, force: bool = False) -> None:
+        """End the captures and show the verdict (asks when fewer than the minimum cycles)."""
+        state = self.app.current_state()
+        if not self.live or state is None or self.capturing:
+            return
+        if state.cycle < state.cycles_min and not force:
+            from station.tui.screens.dialogs import ConfirmScreen
+
+            def finish(sure: bool | None) -> None:
+                if sure:
+                    self.action_finish(force=True)
+
+            self.app.push_screen(
+                ConfirmScreen(
+                    f"Finish with {state.cycle} cycles?",
+                    f"The report asks for {state.cycles_min} to {state.cycles_target}; the "
+                    "verdict is weaker with fewer.",
+                ),
+                callback=finish,
+            )
+            return
+        try:
+            self.app.finish_session()
+        except StationError as error:
+            self._say(error.message, "bold red")
+
+    def action_help(self) -> None:
+        """The keys."""
+        from station.tui.screens.dialogs import HelpScreen
+
+        self.app.push_screen(HelpScreen())
+
+    def action_back(self) -> None:
+        """Reviewing: back to the summary."""
+        if not self.live:
+            self.app.pop_screen()
+
+    def action_leave(self) -> None:
+        """Live: leave the session resumable; reviewing: back."""
+        if not self.live:
+            self.app.pop_screen()
+            return
+        from station.tui.screens.dialogs import ConfirmScreen
+
+        def leave(sure: bool | None) -> None:
+            if sure:
+                self.app.interrupt_session("operator left")
+                self.app.go_home()
+
+        self.app.push_screen(
+            ConfirmScreen(
+                "Leave this session?",
+                "It is kept as interrupted; choose Resume on the home screen to continue.",
+            ),
+            callback=leave,
+        )
+
+
+def session_title(header: Mapping[str, Any]) -> str:
+    """``robot R1 · repeatability`` from a session header's fields."""
+    procedure = header.get("procedure")
+    name = procedure.get("id", "") if isinstance(procedure, Mapping) else str(procedure or "")
+    return f"robot {header.get('robot', '?')} · {name}"
+
+
+def review_view(
+    title: str,
+    channels: Sequence[str],
+    analysis: Any,
+    cycle_numbers: Sequence[int],
+    *,
+    resolution: float | None,
+    unit: str,
+    progress: str,
+) -> DashboardView:
+    """The dashboard of a saved session (read-only)."""
+    return DashboardView(
+        title=title,
+        progress=progress,
+        prompt="Recorded session (read-only). x, y, z or Tab: axis · Escape: back.",
+        channels=tuple(channels),
+        analyses=dict(analysis.channels) if analysis is not None else {},
+        cycle_numbers=tuple(cycle_numbers),
+        resolution=resolution,
+        unit=unit,
+    )

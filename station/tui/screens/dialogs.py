@@ -1,0 +1,122 @@
+"""Small modal dialogs: a typed sentence (reject reason, note), a yes/no question, the help."""
+
+from __future__ import annotations
+
+from rich.text import Text
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import Vertical, VerticalScroll
+from textual.screen import ModalScreen
+from textual.widgets import Footer, Input, Static
+
+from station.tui.widgets.fields import say
+
+
+class TextPrompt(ModalScreen[str | None]):
+    """Asks for one line of text; Enter returns it (refused when empty), Escape cancels."""
+
+    BINDINGS = [Binding("escape", "cancel", "Cancel")]
+
+    def __init__(self, title: str, prompt: str, *, placeholder: str = "") -> None:
+        super().__init__()
+        self._title = title
+        self._prompt = prompt
+        self._placeholder = placeholder
+
+    def compose(self) -> ComposeResult:
+        """Title, question, the input, the error line."""
+        with Vertical(classes="dialog"):
+            yield Static(Text(self._title, style="bold"), classes="dialog-title")
+            yield Static(self._prompt)
+            yield Input(placeholder=self._placeholder, id="prompt-input")
+            yield Static("", classes="field-error", id="prompt-error")
+            yield Static("Enter to save · Escape to cancel", classes="dim")
+        yield Footer()
+
+    def on_mount(self) -> None:
+        """Focus the input."""
+        self.query_one(Input).focus()
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        """Return the text, or say why not."""
+        text = event.value.strip()
+        if not text:
+            say(self.query_one("#prompt-error", Static), "Type a few words first.")
+            return
+        self.dismiss(text)
+
+    def action_cancel(self) -> None:
+        """Close without a value."""
+        self.dismiss(None)
+
+
+class ConfirmScreen(ModalScreen[bool]):
+    """A yes/no question: y or Enter for yes, n or Escape for no."""
+
+    BINDINGS = [
+        Binding("y", "answer(True)", "Yes"),
+        Binding("enter", "answer(True)", "Yes", show=False),
+        Binding("n", "answer(False)", "No"),
+        Binding("escape", "answer(False)", "No", show=False),
+    ]
+
+    def __init__(self, question: str, detail: str = "") -> None:
+        super().__init__()
+        self._question = question
+        self._detail = detail
+
+    def compose(self) -> ComposeResult:
+        """The question and the keys."""
+        with Vertical(classes="dialog"):
+            yield Static(Text(self._question, style="bold"), classes="dialog-title")
+            if self._detail:
+                yield Static(self._detail)
+            yield Static("y = yes · n = no", classes="dim")
+        yield Footer()
+
+    def action_answer(self, answer: bool) -> None:
+        """Close with the answer."""
+        self.dismiss(answer)
+
+
+HELP_TEXT = """\
+[b]Home[/b]  ↑ ↓ choose · Enter open · n new session · r resume · v review · q quit
+
+[b]Set-up[/b]  Tab / Shift+Tab move between fields · F3 test connection · F2 start
+  Limits: ±0.001 (a tolerance about nominal 0) or -0.001:0.001 (LSL:USL); one side may be empty.
+  Port: pick a detected port or type /dev/ttyUSB0, /dev/pts/N, rfc2217://host:port, socket://host:port.
+
+[b]Checklist[/b]  Enter confirms the step (zeroes at a zero step, saves typed values at an
+  input step) · n note · q leave (the session stays resumable)
+
+[b]Capture[/b]  Space capture a cycle · r reject the last cycle (asks why; nothing is deleted)
+  n note · p pause / continue · f finish · x y z or Tab choose the axis in the charts
+  q leave (the session stays resumable)
+
+[b]Summary[/b]  e export the text report · c export CSV · d charts · h home · q quit
+
+Every reading is on disk (fsynced) before it is shown as captured. If the link drops, the
+session is marked interrupted; run `station` again and choose Resume.
+Verdicts: CAPABLE when Cpk ≥ the threshold (1.00 by default), NOT CAPABLE otherwise,
+UNDEFINED when there are no limits or too few readings.
+"""
+
+
+class HelpScreen(ModalScreen[None]):
+    """Every key of every screen, and what the verdict words mean."""
+
+    BINDINGS = [
+        Binding("escape", "close", "Close"),
+        Binding("q", "close", "Close", show=False),
+        Binding("question_mark", "close", "Close", show=False),
+    ]
+
+    def compose(self) -> ComposeResult:
+        """The help text in a scrolling box."""
+        with VerticalScroll(classes="dialog help"):
+            yield Static(HELP_TEXT)
+        yield Footer()
+
+    def action_close(self) -> None:
+        """Back to the screen underneath."""
+        self.dismiss(None)

@@ -1,0 +1,174 @@
+"""The home screen: what this program does, and the choices: resume, new session, review, quit.
+
+An unfinished session is offered first, so after an SSH drop the operator presses Enter and is
+back where they were. The sessions folder in use is said on screen, and in ``station demo`` a
+banner says that the indicators are simulated.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from rich.text import Text
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import Vertical
+from textual.screen import Screen
+from textual.widgets import Footer, OptionList, Static
+from textual.widgets.option_list import Option
+
+if TYPE_CHECKING:
+    from station.tui.app import StationApp
+
+INTRODUCTION = (
+    "Measures how well a robot returns to a taught position, by the 1990 NASA/KSC method: "
+    "three dial indicators on X, Y and Z, 25 to 30 cycles, judged with the mean, σ, skewness, "
+    "a histogram, a control chart and Cp/Cpk. Choose with ↑ ↓ and press Enter."
+)
+
+
+class HomeScreen(Screen[None]):
+    """Resume, new session per procedure, review, quit."""
+
+    BINDINGS = [
+        Binding("n", "new", "New session"),
+        Binding("r", "resume", "Resume"),
+        Binding("v", "review", "Review sessions"),
+        Binding("question_mark", "help", "Help"),
+        Binding("q", "quit", "Quit"),
+    ]
+
+    app: StationApp
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._unfinished: list[Any] = []
+        self._session_count = 0
+        self._load_error = ""
+
+    def compose(self) -> ComposeResult:
+        """Title, introduction, the choices, where the sessions go."""
+        config = self.app.config
+        with Vertical(id="home"):
+            yield Static(Text("station · robot calibration", style="bold"), id="home-title")
+            yield Static(INTRODUCTION, id="home-intro")
+            if config.demo is not None:
+                yield Static(
+                    f"DEMO: {config.demo.description} on {config.demo.url}. Nothing here "
+                    "touches a real robot; follow the steps as if it did.",
+                    id="home-demo",
+                )
+            yield OptionList(id="home-choices")
+            yield Static(id="home-folder")
+        yield Footer()
+
+    def on_mount(self) -> None:
+        """Fill the choices from the sessions folder."""
+        self.reload()
+
+    def reload(self) -> None:
+        """Read the sessions folder again and rebuild the list."""
+        from station.errors import StationError
+
+        config = self.app.config
+        try:
+            from station.session.store import find_unfinished, list_sessions
+
+            self._unfinished = list(find_unfinished(config.sessions_dir))
+            self._session_count = len(list_sessions(config.sessions_dir))
+        except StationError as error:
+            self._unfinished, self._session_count = [], 0
+            self._load_error = error.message
+        choices = self.query_one("#home-choices", OptionList)
+        choices.clear_options()
+        for index, summary in enumerate(self._unfinished):
+            choices.add_option(Option(_resume_label(summary), id=f"resume:{index}"))
+        choices.add_option(
+            Option("New session (choose the procedure, robot, limits and port)", id="new")
+        )
+        choices.add_option(Option(f"Review saved sessions ({self._session_count})", id="review"))
+        choices.add_option(Option("Quit", id="quit"))
+        choices.highlighted = 0
+        choices.focus()
+        folder = Text(f"Sessions folder: {config.sessions_dir}", style="dim")
+        folder.append(f"\n({config.sessions_reason})", style="dim")
+        if self._load_error:
+            folder.append(f"\n{self._load_error}", style="bold red")
+        self.query_one("#home-folder", Static).update(folder)
+
+    def on_option_list_option_selected(self, event: OptionList.OptionSelected) -> None:
+        """Enter on a choice."""
+        choice = event.option.id or ""
+        if choice.startswith("resume:"):
+            self.open_resume(self._unfinished[int(choice.split(":", 1)[1])])
+        elif choice == "new":
+            self.action_new()
+        elif choice == "review":
+            self.action_review()
+        elif choice == "quit":
+            self.app.exit(0)
+
+    def open_new(self, procedure_id: str | None) -> None:
+        """The set-up screen for a new session (of this procedure, else the default one)."""
+        from station.errors import StationError
+        from station.tui.screens.setup import SetupScreen
+
+        try:
+            self.app.catalog.get(procedure_id) if procedure_id else self.app.catalog.ids()[0]
+        except (StationError, IndexError) as error:
+            message = getattr(error, "message", "no procedure is installed")
+            self.query_one("#home-folder", Static).update(Text(message, style="bold red"))
+            return
+        self.app.push_screen(SetupScreen(procedure_id=procedure_id))
+
+    def open_resume(self, summary: Any) -> None:
+        """The set-up screen for resuming this session (the port can be changed)."""
+        from station.tui.screens.setup import SetupScreen
+
+        self.app.push_screen(SetupScreen(resume_path=summary.path))
+
+    def action_new(self) -> None:
+        """A new session; the set-up offers every installed procedure (the procedure catalogue
+        loads there, not here, to keep the start fast)."""
+        demo = self.app.config.demo
+        self.open_new(demo.procedure if demo is not None else None)
+
+    def action_resume(self) -> None:
+        """Resume the newest unfinished session."""
+        if self._unfinished:
+            self.open_resume(self._unfinished[0])
+        else:
+            self.notify("There is no unfinished session to resume.")
+
+    def action_review(self) -> None:
+        """The list of saved sessions."""
+        from station.tui.screens.review import ReviewScreen
+
+        self.app.push_screen(ReviewScreen())
+
+    def action_help(self) -> None:
+        """The keys and what the screens do."""
+        from station.tui.screens.dialogs import HelpScreen
+
+        self.app.push_screen(HelpScreen())
+
+    def action_quit(self) -> None:
+        """Leave the program."""
+        self.app.exit(0)
+
+
+def _resume_label(summary: Any) -> str:
+    """``Resume R1 repeatability, interrupted after 12 of 30 cycles (2026-11-23 17:40)``."""
+    created = str(getattr(summary, "created", ""))[:16].replace("T", " ")
+    status = getattr(summary, "status", "unfinished")
+    cycles = getattr(summary, "cycles", None)
+    target = getattr(summary, "cycles_target", None)
+    done = (
+        f", {cycles} of {target} cycles"
+        if target
+        else (f", {cycles} cycles" if cycles is not None else "")
+    )
+    return (
+        f"Resume: {getattr(summary, 'robot', '?')} {getattr(summary, 'procedure', '')}"
+        f" ({status}{done}, {created})"
+    )

@@ -1,0 +1,314 @@
+"""The summary: the verdict per axis and overall, the 3-D figures, the hints, the file and its
+hash, and the exports (the text report and CSV) into the sessions folder.
+
+It shows the analysis the runner returned on finish, or, when reviewing, the analysis of a saved
+session; the words and figures come from the analysis and the report module, unchanged.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from rich.console import Group
+from rich.table import Table
+from rich.text import Text
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import VerticalScroll
+from textual.screen import Screen
+from textual.widgets import Footer, Static
+
+from station.errors import StationError
+from station.tui.widgets.figures import (
+    VERDICT_STYLES,
+    decimals_for,
+    number,
+    overall_verdict,
+    ratio,
+    verdict_word,
+)
+
+if TYPE_CHECKING:
+    from station.runner import RunnerState
+    from station.tui.app import StationApp
+
+
+@dataclass(frozen=True)
+class SummaryView:
+    """What the summary shows."""
+
+    path: Path
+    header: Mapping[str, Any]
+    analysis: Any
+    last_hash: str
+    status: str
+    cycle_numbers: tuple[int, ...] = ()
+    excluded_cycles: tuple[int, ...] = ()
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    @classmethod
+    def from_live(cls, state: RunnerState, analysis: Any, header: Mapping[str, Any]) -> SummaryView:
+        """After ``finish``: the runner's final state and analysis."""
+        return cls(
+            path=state.path,
+            header=dict(header),
+            analysis=analysis,
+            last_hash=state.last_hash,
+            status=state.status,
+            cycle_numbers=tuple(r.cycle for r in state.cycles if r.rejected is None),
+            excluded_cycles=tuple(r.cycle for r in state.cycles if r.rejected is not None),
+        )
+
+    @classmethod
+    def from_file(cls, path: Path) -> SummaryView:
+        """A saved session, read-only (the file is not changed, not even a torn tail)."""
+        from station.session.model import load_session
+        from station.tui.review_analysis import analyze_session
+
+        session = load_session(path, recover=False)
+        analysis = analyze_session(session)
+        notes = (session.torn.message,) if session.torn is not None else ()
+        return cls(
+            path=path,
+            header=dict(session.header),
+            analysis=analysis,
+            last_hash=session.last_hash,
+            status=session.status,
+            cycle_numbers=session.accepted_cycles,
+            excluded_cycles=session.excluded_cycles,
+            notes=notes,
+        )
+
+    @property
+    def unit(self) -> str:
+        """The session's unit."""
+        return str(self.header.get("unit", ""))
+
+    @property
+    def decimals(self) -> int:
+        """Decimals to show, from the gauge resolution."""
+        resolution = self.header.get("resolution")
+        return decimals_for(float(resolution) if resolution else None)
+
+
+def verdict_text(view: SummaryView) -> Text:
+    """The verdict block: overall, then one line per axis with Cp, Cpk and the reason."""
+    analysis = view.analysis
+    text = Text()
+    if analysis is None:
+        return Text("No accepted cycles: there is nothing to judge yet.", style="bold yellow")
+    words = [verdict_word(c.capability) for c in analysis.channels.values()]
+    overall = overall_verdict(words)
+    text.append("Verdict: ", style="bold")
+    text.append(overall, style=VERDICT_STYLES[overall])
+    threshold = analysis.config.threshold
+    text.append(f"   (capable when Cpk ≥ {threshold:.2f}; unit: {view.unit})\n", style="dim")
+    for name, channel in analysis.channels.items():
+        word = verdict_word(channel.capability)
+        capability = channel.capability
+        descriptive = channel.descriptive
+        text.append(f"  {name}  ", style="bold")
+        text.append(f"{word:<11}", style=VERDICT_STYLES[word])
+        text.append(
+            f" Cp {ratio(capability.cp)}  Cpk {ratio(capability.cpk)} (95%: ≥"
+            f"{ratio(capability.cpk_lower)})  X̄ {number(descriptive.mean, view.decimals)}"
+            f"  σ {number(descriptive.sd, view.decimals, signed=False)}\n"
+        )
+        if word == "UNDEFINED" and capability.message:
+            text.append(f"      {capability.message}\n", style="yellow")
+    return text
+
+
+def spatial_text(view: SummaryView) -> Text:
+    """The 3-D figures: offsets from nominal, the report's total, ISO 9283 RP and AP."""
+    spatial = getattr(view.analysis, "spatial", None)
+    if spatial is None:
+        return Text("")
+    decimals = view.decimals
+    text = Text("3-D\n", style="bold")
+    offsets = "  ".join(f"{axis} {number(v, decimals)}" for axis, v in spatial.offset.items())
+    text.append(f"  offset from nominal: {offsets} {view.unit}\n")
+    text.append(
+        f"  total offset √(Σ offset²) (ISO 9283 APp): "
+        f"{number(spatial.total_offset, decimals, signed=False)} {view.unit}\n"
+    )
+    text.append(
+        f"  ISO 9283 pose repeatability RP = l̄ + 3·S_l: "
+        f"{number(spatial.rp, decimals, signed=False)} {view.unit}\n"
+    )
+    if spatial.message:
+        text.append(f"  {spatial.message}\n", style="yellow")
+    return text
+
+
+def hints_text(view: SummaryView) -> Group | Text:
+    """The report's hints about what the figures point to, as a bulleted list."""
+    hints = tuple(getattr(view.analysis, "hints", ()) or ())
+    if not hints:
+        return Text("")
+    table = Table.grid(padding=(0, 1))
+    table.add_column(width=3, justify="right")
+    table.add_column(ratio=1)
+    for hint in hints:
+        table.add_row("•", hint)
+    return Group(Text("What the figures suggest", style="bold"), table)
+
+
+def file_text(view: SummaryView, exported: list[str]) -> Text:
+    """Where the session file is, its status and the hash that anchors it."""
+    text = Text("Session file\n", style="bold")
+    text.append(f"  {view.path}\n")
+    text.append(f"  status {view.status}; last line hash (write it on the filed report):\n")
+    text.append(f"  {view.last_hash}\n")
+    if view.excluded_cycles:
+        cycles = ", ".join(str(c) for c in view.excluded_cycles)
+        text.append(f"  rejected cycles, left out of the analysis: {cycles}\n")
+    for note in view.notes:
+        text.append(f"  {note}\n", style="yellow")
+    for line in exported:
+        text.append(f"  {line}\n", style="green")
+    return text
+
+
+def _trimmed(text: Text) -> Text:
+    """The text without its last newline (the blocks are spaced by CSS)."""
+    text.rstrip()
+    return text
+
+
+class SummaryScreen(Screen[None]):
+    """The verdict, the figures behind it, and the exports."""
+
+    BINDINGS = [
+        Binding("e", "export_report", "Export report"),
+        Binding("c", "export_csv", "Export CSV"),
+        Binding("d", "dashboard", "Charts"),
+        Binding("h", "home", "Home"),
+        Binding("f1", "help", "Help"),
+        Binding("q", "quit", "Quit"),
+        Binding("escape", "back", "Back", show=False),
+    ]
+
+    app: StationApp
+
+    def __init__(self, view: SummaryView, *, reviewing: bool = False) -> None:
+        super().__init__()
+        self.view = view
+        self.reviewing = reviewing
+        self.exported: list[str] = []
+
+    def compose(self) -> ComposeResult:
+        """The blocks in a scrolling column."""
+        header = self.view.header
+        procedure = header.get("procedure") or {}
+        title = Text("Summary", style="bold")
+        title.append(
+            f"  robot {header.get('robot', '?')} · {procedure.get('id', '')} · operator "
+            f"{header.get('operator') or 'not given'} · {len(self.view.cycle_numbers)} cycles",
+        )
+        yield Static(title, id="summary-title")
+        with VerticalScroll(id="summary-body"):
+            yield Static(_trimmed(verdict_text(self.view)), id="summary-verdict")
+            yield Static(_trimmed(spatial_text(self.view)), id="summary-spatial")
+            yield Static(hints_text(self.view), id="summary-hints")
+            yield Static(file_text(self.view, self.exported), id="summary-file")
+        yield Footer()
+
+    def _refresh_file(self) -> None:
+        self.query_one("#summary-file", Static).update(file_text(self.view, self.exported))
+
+    def _export_path(self, suffix: str) -> Path:
+        """Beside the session file, named after it: never a path from user input."""
+        return self.view.path.with_name(self.view.path.stem + suffix)
+
+    def action_export_report(self) -> None:
+        """The text report (the same as ``station analyze FILE``) beside the session file."""
+        from station.analysis.report import format_report
+
+        if self.view.analysis is None:
+            self.notify("No accepted cycles: there is no report to export.", severity="warning")
+            return
+        target = self._export_path(".report.txt")
+        notes = (
+            f"Session file {self.view.path.name}, status {self.view.status}.",
+            f"Last line hash (anchors the session file): {self.view.last_hash}",
+            *self.view.notes,
+        )
+        report = format_report(
+            self.view.analysis,
+            title=f"BASIC STATISTICS COMPREHENSIVE REPORT ON {self.view.path.name}",
+            notes=notes,
+        )
+        self._write(target, report, "report")
+
+    def action_export_csv(self) -> None:
+        """Every cycle as tidy CSV (rejected ones marked) beside the session file."""
+        import io
+
+        from station.session.export import export_csv
+        from station.session.model import load_session
+
+        try:
+            session = load_session(self.view.path, recover=False)
+        except StationError as error:
+            self.notify(error.message, severity="error")
+            return
+        buffer = io.StringIO()
+        export_csv(session, buffer)
+        self._write(self._export_path(".csv"), buffer.getvalue(), "CSV")
+
+    def _write(self, target: Path, content: str, what: str) -> None:
+        try:
+            target.write_text(content, encoding="utf-8")
+        except OSError as error:
+            self.notify(f"could not write {target}: {error.strerror}", severity="error")
+            return
+        self.exported.append(f"{what} exported to {target}")
+        self._refresh_file()
+        self.notify(f"{what} exported to {target}")
+
+    def action_dashboard(self) -> None:
+        """The statistics table and charts of this session, read-only."""
+        from station.tui.screens.dashboard import DashboardScreen, review_view, session_title
+
+        header = self.view.header
+        resolution = header.get("resolution")
+        cycles = len(self.view.cycle_numbers)
+        self.app.push_screen(
+            DashboardScreen(
+                live=False,
+                view=review_view(
+                    session_title(header),
+                    tuple(header.get("channels") or ()),
+                    self.view.analysis,
+                    self.view.cycle_numbers,
+                    resolution=float(resolution) if resolution else None,
+                    unit=str(header.get("unit", "")),
+                    progress=f"{cycles} accepted cycles, {self.view.status}",
+                ),
+            )
+        )
+
+    def action_home(self) -> None:
+        """Back to the home screen."""
+        self.app.go_home()
+
+    def action_back(self) -> None:
+        """Reviewing: back to the list; after a session: home."""
+        if self.reviewing:
+            self.app.pop_screen()
+        else:
+            self.app.go_home()
+
+    def action_help(self) -> None:
+        """The keys."""
+        from station.tui.screens.dialogs import HelpScreen
+
+        self.app.push_screen(HelpScreen())
+
+    def action_quit(self) -> None:
+        """Leave the program (the session is already saved)."""
+        self.app.exit(0)

@@ -1,0 +1,145 @@
+"""End to end in a real terminal: ``station demo`` under tmux at 80×24, read from the pane.
+
+The first test lets the autopilot walk the whole repeatability procedure and reads the verdict
+words off the summary. The second hangs up the terminal during the captures (``tmux
+kill-session`` sends SIGHUP, as an SSH drop does): the session file must end ``interrupted``, and
+the next ``station`` must offer to resume it on its home screen.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+import time
+import uuid
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.skipif(shutil.which("tmux") is None, reason="tmux is not installed")
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+class Pane:
+    """One detached tmux session running one command at 80×24."""
+
+    def __init__(self, command: list[str], cwd: Path) -> None:
+        self.name = f"station-e2e-{uuid.uuid4().hex[:8]}"
+        env = {"TERM": "xterm-256color", "COLORTERM": "truecolor"}
+        line = " ".join(f"{k}={shlex.quote(v)}" for k, v in env.items())
+        # `exec` so that the pane's process is station itself and receives the hang-up.
+        shell = f"cd {shlex.quote(str(cwd))} && {line} exec {shlex.join(command)}"
+        subprocess.run(
+            ["tmux", "new-session", "-d", "-s", self.name, "-x", "80", "-y", "24", shell],
+            check=True,
+        )
+        subprocess.run(["tmux", "set-option", "-t", self.name, "remain-on-exit", "on"], check=False)
+        self.pid = int(self._tmux("display-message", "-p", "-t", self.name, "#{pane_pid}"))
+
+    def _tmux(self, *args: str) -> str:
+        return subprocess.run(
+            ["tmux", *args], capture_output=True, text=True, check=False
+        ).stdout.strip()
+
+    def screen(self) -> str:
+        """What the 80×24 terminal shows now."""
+        return self._tmux("capture-pane", "-p", "-t", self.name)
+
+    def wait_for(self, text: str, timeout: float) -> str:
+        """The screen once it matches the regular expression ``text``; fails with the last
+        screen after ``timeout``."""
+        deadline = time.monotonic() + timeout
+        screen = ""
+        while time.monotonic() < deadline:
+            screen = self.screen()
+            if re.search(text, screen):
+                return screen
+            time.sleep(0.1)
+        pytest.fail(f"{text!r} did not appear within {timeout} s; the screen shows:\n{screen}")
+
+    def hang_up(self) -> None:
+        """Close the terminal: tmux sends SIGHUP to the pane's process."""
+        subprocess.run(["tmux", "kill-session", "-t", self.name], check=False)
+
+    def close(self) -> None:
+        """Kill the session if it is still there."""
+        subprocess.run(["tmux", "kill-session", "-t", self.name], capture_output=True, check=False)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    # A zombie child of the tmux server counts as gone.
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z"
+    except OSError:
+        return False
+
+
+def _station(*args: str) -> list[str]:
+    return [sys.executable, "-m", "station", *args]
+
+
+def test_autopilot_demo_reaches_the_verdict(tmp_path: Path) -> None:
+    pane = Pane(
+        _station("demo", "--autopilot", "--pace", "0.05", "--sessions", str(tmp_path)), tmp_path
+    )
+    try:
+        pane.wait_for("Verdict:", timeout=90)
+        time.sleep(0.5)  # the summary paints in a few frames
+        screen = pane.wait_for("Export report", timeout=10)  # the footer names the keys
+        assert "Summary" in screen
+        lines = [line.strip() for line in screen.splitlines()]
+        axis_lines = [line for line in lines if line[:2] in ("x ", "y ", "z ")]
+        assert len(axis_lines) == 3, screen
+        for line in axis_lines:
+            assert "CAPABLE" in line or "UNDEFINED" in line, line  # NOT CAPABLE contains it too
+        verdict = next(line for line in lines if line.startswith("Verdict:"))
+        assert verdict.split()[1] in ("CAPABLE", "NOT", "UNDEFINED"), verdict
+        sessions = list((tmp_path / "demo").glob("*.jsonl"))
+        assert len(sessions) == 1
+        verify = subprocess.run(
+            _station("verify", str(sessions[0])), capture_output=True, text=True, cwd=ROOT
+        )
+        assert verify.returncode == 0, verify.stdout + verify.stderr
+    finally:
+        pane.close()
+
+
+def test_hang_up_during_capture_leaves_a_resumable_session(tmp_path: Path) -> None:
+    pane = Pane(
+        _station("demo", "--autopilot", "--pace", "0.1", "--sessions", str(tmp_path)), tmp_path
+    )
+    try:
+        pane.wait_for(r"cycle ([2-9]|[12]\d) of 30", timeout=60)
+        pane.hang_up()
+        deadline = time.monotonic() + 15
+        while _alive(pane.pid) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not _alive(pane.pid), "station did not exit on SIGHUP"
+    finally:
+        pane.close()
+
+    sessions = list((tmp_path / "demo").glob("*.jsonl"))
+    assert len(sessions) == 1
+    from station.session.model import load_session
+
+    session = load_session(sessions[0], recover=False)
+    assert session.status == "interrupted"
+    assert len(session.accepted_cycles) >= 2
+    assert any(event.get("type") == "interrupted" for event in session.events)
+
+    second = Pane(_station("--sessions", str(tmp_path / "demo")), tmp_path)
+    try:
+        screen = second.wait_for("Resume:", timeout=30)
+        assert "interrupted" in screen
+        assert "demo-robot" in screen
+    finally:
+        second.close()

@@ -1,0 +1,86 @@
+"""Shared pieces of the TUI tests: the simulated fixture on a real pty, and walking the screens
+by keyboard in Pilot (set-up, checklist, cycles)."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+from types import SimpleNamespace
+
+import pytest
+from textual.widgets import Input
+
+from station.tui.instruments import DemoFixture, start_demo_fixture
+
+
+@pytest.fixture
+def fixture_pty() -> Iterator[DemoFixture]:
+    """The demo's seeded simulated fixture (x fine, y off-centre and noisy, z warming up, so
+    a control-chart rule fires) on a real pseudo-terminal."""
+    fixture = start_demo_fixture(1990)
+    try:
+        yield fixture
+    finally:
+        fixture.stop()
+
+
+async def wait_until(pilot, condition: Callable[[], object], timeout: float = 10.0) -> None:
+    """Let the app run until ``condition()`` is true; fail after ``timeout`` seconds."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout} s waiting for {condition}")
+        await pilot.pause(0.02)
+
+
+async def open_setup(pilot, robot: str, port: str, operator: str = "operator-1") -> None:
+    """Home → ``n`` → the set-up, with the robot typed and the port and operator filled in."""
+    from station.tui.screens.setup import SetupScreen
+
+    app = pilot.app
+    await pilot.press("n")
+    await wait_until(pilot, lambda: isinstance(app.screen, SetupScreen))
+    await pilot.pause()
+    await pilot.press(*robot)
+    app.screen.query_one("#port", Input).value = port
+    app.screen.query_one("#operator", Input).value = operator
+    app.screen.query_one("#map", Input).value = "1=x,2=y,3=z"
+
+
+async def walk_checklist(pilot) -> int:
+    """Enter on each checklist step until the dashboard is up; returns the steps done."""
+    from station.tui.screens.checklist import ChecklistScreen
+    from station.tui.screens.dashboard import DashboardScreen
+
+    app = pilot.app
+    await wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen | DashboardScreen))
+    done = 0
+    while not isinstance(app.screen, DashboardScreen):
+        before = app.runner.state().current.index
+        await pilot.press("enter")
+        await wait_until(pilot, lambda before=before: app.runner.state().current.index != before)
+        done += 1
+    await pilot.pause()
+    return done
+
+
+async def capture_one(pilot) -> None:
+    """Space on the dashboard, and wait until the cycle is recorded and drawn."""
+    app = pilot.app
+    dashboard = app.screen
+    count = len(app.runner.state().cycles)
+    await pilot.press("space")
+    await wait_until(
+        pilot, lambda: len(app.runner.state().cycles) > count and not dashboard.capturing
+    )
+
+
+@pytest.fixture
+def tui() -> SimpleNamespace:
+    """The walking helpers above, for the tests of this folder."""
+    return SimpleNamespace(
+        wait_until=wait_until,
+        open_setup=open_setup,
+        walk_checklist=walk_checklist,
+        capture_one=capture_one,
+    )
