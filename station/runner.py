@@ -46,7 +46,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -135,6 +135,10 @@ class SessionSetup:
     cycles: int | None = None
     rule_set: str = "report"
     threshold: float = 1.0
+    placements: int | None = None
+    """How many times each ``repeat`` block runs (fixture placements); ``None``: its target."""
+    strokes: int | None = None
+    """How many whole strokes each ``stroke`` step asks for; ``None``: its target."""
 
     def __post_init__(self) -> None:
         if not self.robot.strip():
@@ -145,6 +149,10 @@ class SessionSetup:
             )
         if self.cycles is not None and self.cycles < 1:
             raise StationError(f"cycles must be at least 1, not {self.cycles}")
+        if self.placements is not None and self.placements < 1:
+            raise StationError(f"placements must be at least 1, not {self.placements}")
+        if self.strokes is not None and self.strokes < 1:
+            raise StationError(f"strokes must be at least 1, not {self.strokes}")
         if self.resolution is not None and not (
             math.isfinite(self.resolution) and self.resolution > 0
         ):
@@ -216,6 +224,8 @@ class SessionSetup:
                 "ports": [port.header() for port in self.ports],
             },
             "cycles_target": self.resolved_cycles,
+            **({"placements_target": self.placements} if self.placements else {}),
+            **({"strokes_target": self.strokes} if self.strokes else {}),
             "rules": self.rule_set,
             "threshold": self.threshold,
         }
@@ -299,6 +309,18 @@ class StrokeOutcome:
     points: int
     skipped: int
     message: str
+    direction: str = ""
+    """``A→B`` or ``B→A`` when the travel split the stroke (:meth:`Runner.stream_strokes`)."""
+    count: int = 0
+    """Whole strokes recorded in the step with this one (the k of "stroke k of N")."""
+    profile: Mapping[str, tuple[float, ...]] = field(default_factory=dict)
+    """The stroke's points per channel (streamed strokes only), for a per-stroke figure."""
+
+    def line(self) -> str:
+        """The one-line form ``stroke 7 A→B 412 points`` (the count, not the file's number)."""
+        return f"stroke {self.count or self.stroke} {self.direction} {self.points} points".replace(
+            "  ", " "
+        )
 
 
 @dataclass(frozen=True)
@@ -431,6 +453,7 @@ def setup_from_header(
         if spec.get("lsl") is not None or spec.get("usl") is not None
     }
     cycles = header.get("cycles_target")
+    placements, strokes = header.get("placements_target"), header.get("strokes_target")
     return SessionSetup(
         procedure=procedure,
         robot=str(header["robot"]),
@@ -443,6 +466,8 @@ def setup_from_header(
         cycles=int(cycles) if isinstance(cycles, int) else None,
         rule_set=str(header.get("rules") or "report"),
         threshold=float(header.get("threshold") or 1.0),
+        placements=placements if isinstance(placements, int) else None,
+        strokes=strokes if isinstance(strokes, int) else None,
     )
 
 
@@ -500,11 +525,11 @@ class _PlanItem:
         return (self.step.id, self.placement)
 
 
-def _unroll(procedure: Procedure) -> tuple[_PlanItem, ...]:
+def _unroll(procedure: Procedure, placements: int | None = None) -> tuple[_PlanItem, ...]:
     items: list[_PlanItem] = []
     for step in procedure.steps:
         if step.kind == "repeat":
-            count = int(step.count_target or 1)
+            count = int(placements or step.count_target or 1)
             for placement in range(1, count + 1):
                 items.extend(_PlanItem(inner, placement, count) for inner in step.steps)
         else:
@@ -536,7 +561,7 @@ class Runner:
         self._outcome_ready = threading.Condition(self._lock)
         self._outcomes = 0
         self._last_outcome: CycleOutcome | None = None
-        self._plan = _unroll(setup.procedure)
+        self._plan = _unroll(setup.procedure, setup.placements)
         self._position = 0
         self._status: RunnerStatus = "running"
         self._busy = False
@@ -548,6 +573,11 @@ class Runner:
         self._next_cycle = 1
         # Strokes recorded per (step id, placement); the stroke under way and its stop signal.
         self._strokes: dict[tuple[str, int | None], int] = {}
+        # The last stroke number written per step: partial segments (a lead-in, a stroke cut
+        # by an interruption) keep their own numbers, so numbers never repeat.
+        self._stroke_numbers: dict[tuple[str, int | None], int] = {}
+        self._stream_queue: queue.SimpleQueue[Any] | None = None
+        self._warned_position = -1
         self._stroke_points = 0
         self._stroke_stop = threading.Event()
         self._messages: deque[OperatorMessage] = deque(maxlen=_MESSAGES_KEPT)
@@ -656,9 +686,16 @@ class Runner:
                 )
             self._next_cycle = session.next_cycle
             by_seq = {event["seq"]: event for event in session.events}
+            marked = any(by_seq[batch.seq].get("end") for batch in session.samples)
             for batch in session.samples:
-                key = (batch.step, by_seq[batch.seq].get("placement"))
-                self._strokes[key] = max(self._strokes.get(key, 0), batch.stroke or 0)
+                event = by_seq[batch.seq]
+                key = (batch.step, event.get("placement"))
+                number = batch.stroke or 0
+                self._stroke_numbers[key] = max(self._stroke_numbers.get(key, 0), number)
+                if not marked:  # a file from before the end marks: every number is a stroke
+                    self._strokes[key] = max(self._strokes.get(key, 0), number)
+                elif event.get("end"):
+                    self._strokes[key] = self._strokes.get(key, 0) + 1
             self._rebuild_live()
             self._views = ()
 
@@ -707,13 +744,20 @@ class Runner:
         Recording (an fsync, the live figures) happens on the runner's own thread, so the
         reader keeps draining the line while the disk works."""
         with self._lock:
+            if self._stream_queue is not None:
+                self._stream_queue.put(result)  # a streamed stroke takes every set, in order
+                return
             if self._busy or self._status != "running":
                 return  # a software zero is taking this set, or the session is not running
             if not self._capture_step():
-                self._say(
-                    "warning",
-                    "A reading set arrived while no capture step is current; it was not recorded.",
-                )
+                # Said once per step: a streaming device sends many sets a second.
+                if self._warned_position != self._position:
+                    self._warned_position = self._position
+                    self._say(
+                        "warning",
+                        "Reading sets arrive while no capture step is current; they are not "
+                        "recorded.",
+                    )
                 return
             position = self._position
         self._push_sets.put((position, result))
@@ -919,28 +963,18 @@ class Runner:
             self._claim()
             self._stroke_stop.clear()
             self._stroke_points = 0
-            number = self._strokes.get(item.key, 0) + 1
+            number = self._stroke_numbers.get(item.key, 0) + 1
+            self._stroke_numbers[item.key] = number
         channels = list(item.step.channels)
         rows: list[list[float]] = []
         stamps: list[float] = []
         points = skipped = 0
         flushed_at = time.monotonic()
 
-        def flush() -> None:
+        def flush(end: bool = False) -> None:
             nonlocal rows, stamps, flushed_at
             if rows:
-                with self._lock:
-                    self._ensure_open()
-                    self._append(
-                        "samples",
-                        step=item.step.id,
-                        placement=item.placement,
-                        stroke=number,
-                        channels=channels,
-                        values=rows,
-                        t_mono=stamps,
-                        by=by,
-                    )
+                self._write_samples(item, number, channels, rows, stamps, by, end=end)
             rows, stamps, flushed_at = [], [], time.monotonic()
 
         try:
@@ -955,14 +989,14 @@ class Runner:
                 self._stroke_points = points
                 if len(rows) >= batch_points or time.monotonic() - flushed_at >= batch_seconds:
                     flush()
-            flush()
+            flush(end=True)  # the operator ended it: a whole stroke by their word
         finally:
             with self._lock:
                 self._busy = False
                 self._stroke_points = 0
         with self._lock:
             if points:
-                self._strokes[item.key] = number
+                self._strokes[item.key] = self._strokes.get(item.key, 0) + 1
                 message = f"Stroke {number}: {points} points recorded"
             else:
                 message = f"Stroke {number}: no complete reading set; nothing recorded"
@@ -970,6 +1004,187 @@ class Runner:
                 message += f", {skipped} incomplete sets skipped"
             self._say("info" if points else "warning", message + ".")
             return StrokeOutcome(number if points else 0, points, skipped, message + ".")
+
+    def stream_strokes(
+        self,
+        timeout: float = 1.0,
+        *,
+        deadband: float | None = None,
+        still_seconds: float = 2.0,
+        batch_seconds: float = 0.25,
+        batch_points: int = 200,
+        on_stroke: Callable[[StrokeOutcome], object] | None = None,
+        by: str = "operator",
+    ) -> int:
+        """Stream the current ``stroke`` step's channels and split the strokes by the travel
+        of its direction channel (the scale) as they happen, until the step has its target of
+        whole strokes, :meth:`end_stroke`, or the session stops (blocking: call it from a
+        worker thread). Returns the whole strokes recorded in the step so far.
+
+        Every complete set is a point and every point is written, in ``samples`` events
+        numbered by stroke (one per ``batch_seconds`` or ``batch_points``, so the fsync cost
+        stays bounded); the last event of a whole stroke carries ``end: true``. A whole stroke
+        runs from rest or a reversal to a reversal or rest
+        (:class:`~station.analysis.linearity.TravelTracker`, ``deadband`` default 100 gauge
+        resolutions, ``still_seconds`` at rest to end one); a lead-in (the robot was moving
+        when streaming began) or a stroke cut short keeps its own number without the mark, and
+        the analysis leaves it out. ``on_stroke`` hears of each whole stroke once its points
+        are on disk. With the ``push`` trigger every set the devices send is taken (queued
+        from the reader's thread, none dropped); otherwise the gauges are polled back to back.
+        """
+        from station.analysis.linearity import TravelTracker
+
+        with self._lock:
+            item = self._current_item()
+            if self._status == "paused":
+                raise StationError("capture is paused: resume it first")
+            if item.step.kind != "stroke":
+                raise StationError(f"step {item.step.title!r} is not a stroke")
+            if not item.step.direction_channel:
+                raise StationError(f"step {item.step.title!r} names no direction channel")
+            self._claim()
+            self._stroke_stop.clear()
+            pushed = self.setup.trigger == "push"
+            if pushed:
+                self._stream_queue = queue.SimpleQueue()
+        channels = list(item.step.channels)
+        scale = channels.index(item.step.direction_channel)
+        target, _ = self._stroke_counts(item)
+        resolution = self.setup.resolved_resolution
+        tracker = TravelTracker(
+            deadband if deadband is not None else 100 * resolution, still_seconds=still_seconds
+        )
+        # Points of the segment under way: written in batches, the whole segment kept until it
+        # closes (one stroke's worth) for the listener's per-stroke figure.
+        segment: list[tuple[list[float], float]] = []
+        written = 0
+        number = 0
+        skipped = 0
+        flushed_at = time.monotonic()
+
+        def open_segment() -> None:
+            nonlocal number, written, segment
+            with self._lock:
+                number = self._stroke_numbers.get(item.key, 0) + 1
+                self._stroke_numbers[item.key] = number
+            segment, written = [], 0
+
+        def flush(end: bool = False, last: bool = False) -> None:
+            nonlocal written, flushed_at
+            # Keep the last point back until the segment ends (or streaming does), so its end
+            # mark always comes with at least one point.
+            upto = len(segment) if end or last else len(segment) - 1
+            if upto > written:
+                rows = [row for row, _ in segment[written:upto]]
+                stamps = [stamp for _, stamp in segment[written:upto]]
+                self._write_samples(item, number, channels, rows, stamps, by, end=end)
+                written = upto
+            flushed_at = time.monotonic()
+
+        def next_result() -> Any:
+            if pushed:
+                try:
+                    return self._stream_queue.get(timeout=timeout)
+                except queue.Empty:
+                    return None
+            return self.gauges.capture(timeout)
+
+        open_segment()
+        try:
+            while not self._stroke_stop.is_set() and self._status == "running":
+                with self._lock:
+                    if self._strokes.get(item.key, 0) >= target:
+                        break
+                result = next_result()
+                if result is None:
+                    continue
+                if _set_problem(result, channels, self.setup.resolved_unit):
+                    skipped += 1
+                    continue
+                row = [float(result.readings[ch].value) for ch in channels]
+                stamp = max(result.readings[ch].t_mono for ch in channels)
+                for event in tracker.add((row, stamp), row[scale], stamp):
+                    if event.kind == "points":
+                        segment.extend(event.points)
+                        continue
+                    flush(end=event.stroke, last=True)
+                    if event.stroke:
+                        self._stroke_done(item, number, segment, channels, event, on_stroke)
+                    open_segment()
+                self._stroke_points = len(segment)
+                if (
+                    len(segment) - written >= batch_points
+                    or time.monotonic() - flushed_at >= batch_seconds
+                ):
+                    flush()
+            segment.extend(tracker.flush())
+            if self._status == "running":
+                flush(last=True)  # a segment still open: recorded, without the end mark
+        finally:
+            with self._lock:
+                self._stream_queue = None
+                self._busy = False
+                self._stroke_points = 0
+        if skipped:
+            self._say("warning", f"{skipped} incomplete reading sets were skipped.")
+        with self._lock:
+            return self._strokes.get(item.key, 0)
+
+    def _stroke_done(
+        self,
+        item: _PlanItem,
+        number: int,
+        segment: Sequence[tuple[list[float], float]],
+        channels: Sequence[str],
+        event: Any,
+        on_stroke: Callable[[StrokeOutcome], object] | None,
+    ) -> None:
+        with self._lock:
+            count = self._strokes.get(item.key, 0) + 1
+            self._strokes[item.key] = count
+            target, _ = self._stroke_counts(item)
+        profile = {
+            channel: tuple(row[index] for row, _ in segment)
+            for index, channel in enumerate(channels)
+        }
+        outcome = StrokeOutcome(
+            stroke=number,
+            points=len(segment),
+            skipped=0,
+            message=f"Stroke {count} of {target} ({event.direction}): {len(segment)} points.",
+            direction=event.direction,
+            count=count,
+            profile=profile,
+        )
+        self._say("info", outcome.message)
+        if on_stroke is not None:
+            on_stroke(outcome)
+
+    def _write_samples(
+        self,
+        item: _PlanItem,
+        number: int,
+        channels: Sequence[str],
+        rows: Sequence[Sequence[float]],
+        stamps: Sequence[float],
+        by: str,
+        *,
+        end: bool,
+    ) -> None:
+        """One ``samples`` event of stroke ``number`` (``end``: the stroke's last points)."""
+        with self._lock:
+            self._ensure_open()
+            self._append(
+                "samples",
+                step=item.step.id,
+                placement=item.placement,
+                stroke=number,
+                channels=list(channels),
+                values=[list(row) for row in rows],
+                t_mono=list(stamps),
+                by=by,
+                end=True if end else None,
+            )
 
     def end_stroke(self) -> None:
         """Stop the stroke under way (its last points are written before :meth:`stroke`
@@ -1179,8 +1394,8 @@ class Runner:
         return target, min(int(step.count_min or target), target)
 
     def _stroke_counts(self, item: _PlanItem) -> tuple[int, int]:
-        """(target, minimum) strokes of a stroke step."""
-        target = int(item.step.count_target or 1)
+        """(target, minimum) strokes of a stroke step (the set-up's count when it gives one)."""
+        target = int(self.setup.strokes or item.step.count_target or 1)
         return target, min(int(item.step.count_min or target), target)
 
     def _step_accepted(self, item: _PlanItem) -> int:
@@ -1433,3 +1648,9 @@ def resume_setup(
         raise StationError(f"session {path} is finished; start a new session instead")
     procedure = discover_procedures(procedures_dirs).get(session.procedure_id)
     return setup_from_header(session.header, procedure, ports=ports)
+
+
+def plan_steps(setup: SessionSetup) -> tuple[tuple[Step, int | None], ...]:
+    """The steps a session of ``setup`` walks, in order, each with its placement (a repeat
+    block's steps once per placement; ``None`` outside one)."""
+    return tuple((item.step, item.placement) for item in _unroll(setup.procedure, setup.placements))

@@ -30,9 +30,10 @@ chart and run rules as the repeatability readings
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 from station.errors import StationError
 
@@ -316,6 +317,121 @@ def split_strokes(
             )
         )
     return strokes
+
+
+@dataclass(frozen=True)
+class TravelEvent:
+    """What :class:`TravelTracker` learnt from a point: ``points`` (tokens, in order) now
+    definitely belong to the segment under way; ``close`` ends that segment first (with its
+    ``direction`` and whether it is a whole ``stroke``: it began at rest or at a reversal, and
+    it ended at a reversal or at rest)."""
+
+    kind: Literal["points", "close"]
+    points: tuple[Any, ...] = ()
+    direction: str = ""
+    stroke: bool = False
+
+
+class TravelTracker:
+    """Split a live stream by the scale's direction of travel, point by point (the live twin
+    of :func:`turning_points`: the same hysteresis, so noise and a dwell within ``deadband``
+    never make a reversal).
+
+    Each point is given with an opaque token. A point is *definite* once it is known which
+    segment of travel it belongs to: every point up to the running extreme is; the points past
+    it wait until the scale either goes further (they join the segment) or comes back by more
+    than the deadband (the segment closes at the extreme and they start the next one). A
+    segment also closes when the scale has stayed within the deadband of its extreme for
+    ``still_seconds`` (the robot stopped at an end). A segment is a whole stroke when it
+    began at rest (``rest_points`` points within the deadband first) or at a reversal, and
+    ended at a reversal or at rest. The points waiting are at most the deadband's worth of
+    travel plus a dwell: memory stays bounded however long the stream.
+    """
+
+    def __init__(
+        self,
+        deadband: float,
+        *,
+        still_seconds: float = 2.0,
+        rest_points: int = 5,
+        a_to_b: int = 1,
+    ) -> None:
+        if not deadband > 0:
+            raise StationError(f"the deadband must be positive, not {deadband}.")
+        self.deadband = float(deadband)
+        self.still_seconds = float(still_seconds)
+        self.rest_points = int(rest_points)
+        self.a_to_b = a_to_b
+        self._direction = 0
+        self._extreme = 0.0
+        self._extreme_t = 0.0
+        self._low = self._high = math.nan
+        self._resting = 0
+        self._from_rest_or_turn = False
+        self._waiting: list[Any] = []
+        self._waiting_values: list[float] = []
+
+    @property
+    def moving(self) -> bool:
+        """True once the segment under way has left its start by more than the deadband."""
+        return self._direction != 0
+
+    def add(self, token: Any, s: float, t: float) -> list[TravelEvent]:
+        """Take one point (scale reading ``s`` at monotonic time ``t``)."""
+        events: list[TravelEvent] = []
+        if self._direction == 0:
+            if math.isnan(self._low):
+                self._low = self._high = s
+            self._low, self._high = min(self._low, s), max(self._high, s)
+            if s - self._low > self.deadband or self._high - s > self.deadband:
+                self._direction = 1 if s - self._low > self.deadband else -1
+                self._from_rest_or_turn = self._from_rest_or_turn or (
+                    self._resting >= self.rest_points
+                )
+                self._extreme, self._extreme_t = s, t
+            else:
+                self._resting += 1
+            return [TravelEvent("points", (token,))]
+        beyond = s >= self._extreme if self._direction > 0 else s <= self._extreme
+        if beyond:
+            self._extreme, self._extreme_t = s, t
+            events.append(TravelEvent("points", (*self._waiting, token)))
+            self._waiting, self._waiting_values = [], []
+            return events
+        if abs(s - self._extreme) > self.deadband:
+            events.append(self._close())
+            self._direction = -self._direction
+            self._from_rest_or_turn = True
+            self._extreme, self._extreme_t = s, t
+            events.append(TravelEvent("points", (*self._waiting, token)))
+            self._waiting, self._waiting_values = [], []
+            return events
+        self._waiting.append(token)
+        self._waiting_values.append(s)
+        if t - self._extreme_t >= self.still_seconds:
+            events.append(self._close())
+            # Still at an end: the next segment starts at rest with the points that waited.
+            self._direction = 0
+            self._from_rest_or_turn = True
+            self._resting = len(self._waiting)
+            self._low = min(self._waiting_values)
+            self._high = max(self._waiting_values)
+            events.append(TravelEvent("points", tuple(self._waiting)))
+            self._waiting, self._waiting_values = [], []
+        return events
+
+    def flush(self) -> list[Any]:
+        """The points still waiting (the stream ended): they belong to the segment under way,
+        which stays open."""
+        waiting, self._waiting, self._waiting_values = self._waiting, [], []
+        return waiting
+
+    def _close(self) -> TravelEvent:
+        return TravelEvent(
+            "close",
+            direction=_direction(float(self._direction), self.a_to_b),
+            stroke=self._from_rest_or_turn,
+        )
 
 
 @dataclass(frozen=True, eq=False)  # arrays: compare the fields, not the objects

@@ -208,6 +208,12 @@ def linearity_profiles(source: Source, path: Path) -> list[Any]:
             columns["stroke"], columns["s"], {"h": columns["h"], "v": columns["v"]}
         )
     batches = [b for b in source.session.samples if {"s", "h", "v"} <= set(b.channels)]
+    # A runner marks the last event of each whole stroke (`end`); a lead-in or a stroke cut
+    # short by an interruption has no mark and is left out. Files without marks: every stroke.
+    ended = {event["seq"] for event in source.session.events if event.get("end")}
+    if ended:
+        whole = {b.stroke for b in batches if b.seq in ended}
+        batches = [b for b in batches if b.stroke in whole]
     if not batches:
         raise StationError(
             f"{path}: the session has no streamed strokes (samples events with h, v and s) "

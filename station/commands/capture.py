@@ -8,6 +8,19 @@ values, zero steps zero, and each cycle is captured until the cycles step has it
 a script saw is in the file, whatever happens next. The summary ends with the session file and
 its last hash.
 
+Relative accuracy (a ``repeat`` block per fixture placement, ``--placements N``): the teach
+pendant's X, Y, Z differ per placement, so ``--input P:NAME=VALUE`` gives a value for placement
+P only (``--input NAME=VALUE`` serves every placement), and ``--inputs FILE`` reads a CSV with a
+``placement`` column and one column per field (``placement,x,y,z``): the operator copies the
+pendant's display there. Every value is checked before anything is written.
+
+Linearity (a ``stroke`` step, ``--strokes N``): h, v and s stream without a pause (use
+``--trigger push`` with a counter that sends continuously); the strokes are split live by the
+scale's direction of travel (:meth:`~station.runner.Runner.stream_strokes`), and a line
+``stroke 7 A→B 412 points h=0.00123 v=0.00061 (LS straightness)`` is printed once that
+stroke's points are on disk. The command stops after N whole strokes and ends with the
+procedure's report (the same as ``station analyze FILE``).
+
 Exit codes: 0 finished; 2 a one-line error (bad option, no port, a failed write such as a full
 disk, no complete reading set after ``--attempts`` tries); 128 + the signal number after
 SIGHUP (129), SIGINT (130) or SIGTERM (143): an ``interrupted`` event is written and the session
@@ -67,10 +80,30 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--input",
-        metavar="NAME=VALUE",
+        metavar="[P:]NAME=VALUE",
         action="append",
         default=[],
-        help="a value for an input step's field (repeatable)",
+        help="a value for an input step's field, for placement P only with P: (repeatable)",
+    )
+    parser.add_argument(
+        "--inputs",
+        metavar="FILE",
+        help="a CSV of input values per placement: a placement column and one per field",
+    )
+    parser.add_argument(
+        "--placements", metavar="N", help="fixture placements of a repeat block (procedure's)"
+    )
+    parser.add_argument("--strokes", metavar="N", help="whole strokes to stream (procedure's)")
+    parser.add_argument(
+        "--deadband",
+        metavar="D",
+        help="stroke splitting: the scale's reversal that ends a stroke (100 resolutions)",
+    )
+    parser.add_argument(
+        "--still",
+        default="2",
+        metavar="S",
+        help="stroke splitting: seconds at rest that end a stroke (2)",
     )
     parser.add_argument(
         "--sessions", metavar="DIR", help="sessions folder (default: STATION_SESSIONS, ...)"
@@ -110,14 +143,64 @@ def _positive(text: str, option: str, kind: type = float) -> Any:
     return value
 
 
-def _parse_inputs(items: list[str]) -> dict[str, str]:
-    values: dict[str, str] = {}
+Inputs = dict[int | None, dict[str, str]]
+"""Typed values by placement (``None``: for every placement and for steps outside a block)."""
+
+
+def _parse_inputs(items: list[str], table: str | None = None) -> Inputs:
+    """``--input [P:]NAME=VALUE`` values and the rows of an ``--inputs`` CSV, by placement."""
+    values: Inputs = {None: {}}
     for item in items:
         name, equals, value = item.partition("=")
+        placement, colon, field_name = name.partition(":")
+        number: int | None = None
+        if colon:
+            try:
+                number = int(placement)
+            except ValueError:
+                number = 0
+            if number < 1:
+                raise StationError(
+                    f"--input {item!r}: the placement before ':' must be 1, 2, 3, ..."
+                )
+            name = field_name
         if not equals or not name.strip():
-            raise StationError(f"--input {item!r} is not NAME=VALUE; write e.g. --input x=12.5")
-        values[name.strip()] = value.strip()
+            raise StationError(
+                f"--input {item!r} is not [P:]NAME=VALUE; write e.g. --input x=12.5 or "
+                "--input 2:x=12.5"
+            )
+        values.setdefault(number, {})[name.strip()] = value.strip()
+    if table:
+        for number, row in _read_inputs(table).items():
+            values.setdefault(number, {}).update(row)
     return values
+
+
+def _read_inputs(path: str) -> dict[int, dict[str, str]]:
+    import csv
+
+    try:
+        with open(path, newline="", encoding="utf-8") as handle:
+            rows = list(csv.DictReader(handle))
+    except OSError as error:
+        raise StationError(f"--inputs {path}: {error.strerror or error}") from None
+    table: dict[int, dict[str, str]] = {}
+    for line, row in enumerate(rows, start=2):
+        row = {(k or "").strip().lower(): (v or "").strip() for k, v in row.items()}
+        try:
+            number = int(row.pop("placement"))
+        except (KeyError, ValueError):
+            raise StationError(
+                f"--inputs {path} line {line}: needs a placement column of whole numbers "
+                "(placement,x,y,z)"
+            ) from None
+        table[number] = row
+    return table
+
+
+def _values_for(inputs: Inputs, placement: int | None) -> dict[str, str]:
+    """The values that answer an input step at ``placement``."""
+    return {**inputs.get(None, {}), **(inputs.get(placement, {}) if placement else {})}
 
 
 def _setup(args: argparse.Namespace) -> Any:
@@ -152,6 +235,8 @@ def _setup(args: argparse.Namespace) -> Any:
         trigger=args.trigger,
         limits=limits or None,
         cycles=_positive(args.cycles, "--cycles", int) if args.cycles else None,
+        placements=_positive(args.placements, "--placements", int) if args.placements else None,
+        strokes=_positive(args.strokes, "--strokes", int) if args.strokes else None,
     )
 
 
@@ -175,26 +260,25 @@ def _resume_setup(args: argparse.Namespace) -> Any:
     return resume_setup(args.resume, procedures_dirs=args.procedures, ports=(port,))
 
 
-def _check_answerable(procedure: Any, inputs: dict[str, str], done: set[str]) -> None:
+def _check_answerable(runner_plan: Any, procedure: Any, inputs: Inputs, done: set) -> None:
     """Refuse, before anything is written, a procedure this command cannot walk alone
-    (``done``: ids of the steps a resumed session already confirmed)."""
-    for step in procedure.all_steps():
-        if step.id in done:
+    (``runner_plan``: the unrolled steps as (step, placement); ``done``: the (step id,
+    placement) pairs a resumed session already confirmed)."""
+    for step, placement in runner_plan:
+        if (step.id, placement) in done or step.kind != "input":
             continue
-        if step.kind == "stroke":
+        given = _values_for(inputs, placement)
+        needed = [f.name for f in step.fields if f.required and f.name not in given]
+        if needed:
+            prefix = f"{placement}:" if placement else ""
+            where = f" at placement {placement}" if placement else ""
             raise StationError(
-                f"station capture cannot run stroke steps (step {step.title!r} of "
-                f"{procedure.id}): an operator starts and ends each stroke as the robot moves"
+                f"step {step.title!r}{where} asks for {', '.join(needed)}: pass "
+                + " ".join(f"--input {prefix}{name}=VALUE" for name in needed)
+                + (" (or --inputs FILE with a row per placement)" if placement else "")
             )
-        if step.kind == "input":
-            needed = [f.name for f in step.fields if f.required and f.name not in inputs]
-            if needed:
-                raise StationError(
-                    f"step {step.title!r} asks for {', '.join(needed)}: pass "
-                    + " ".join(f"--input {name}=VALUE" for name in needed)
-                )
     known = {f.name for step in procedure.all_steps() for f in step.fields}
-    unknown = sorted(set(inputs) - known)
+    unknown = sorted({name for values in inputs.values() for name in values} - known)
     if unknown:
         raise StationError(
             f"--input {', '.join(unknown)}: procedure {procedure.id} asks for no such value"
@@ -206,11 +290,22 @@ class _Headless:
     """Walks the runner through the procedure on a worker thread; the main thread keeps the
     signals, so an interrupt never lands in the middle of a journal write."""
 
-    def __init__(self, runner: Any, inputs: dict[str, str], timeout: float, attempts: int) -> None:
+    def __init__(
+        self,
+        runner: Any,
+        inputs: Inputs,
+        timeout: float,
+        attempts: int,
+        *,
+        deadband: float | None = None,
+        still: float = 2.0,
+    ) -> None:
         self.runner = runner
         self.inputs = inputs
         self.timeout = timeout
         self.attempts = attempts
+        self.deadband = deadband
+        self.still = still
         self.error: StationError | None = None
         self.done = threading.Event()
 
@@ -235,7 +330,21 @@ class _Headless:
             elif step.kind == "zero":
                 runner.zero(by=BY)
             elif step.kind == "input":
-                runner.submit_input(self._values_for(step), by=BY)
+                given = _values_for(self.inputs, state.current.placement)
+                # _check_answerable made sure every required field has a value; the runner
+                # checks them.
+                values = {f.name: given[f.name] for f in step.fields if f.name in given}
+                runner.submit_input(values, by=BY)
+            elif step.kind == "stroke" and state.strokes >= state.strokes_target:
+                runner.confirm(by=BY)
+            elif step.kind == "stroke":
+                runner.stream_strokes(
+                    self.timeout,
+                    deadband=self.deadband,
+                    still_seconds=self.still,
+                    on_stroke=_print_stroke,
+                    by=BY,
+                )
             elif step.kind == "cycles" and state.cycle >= state.cycles_target:
                 runner.confirm(by=BY)
             elif step.kind in ("cycles", "capture"):
@@ -254,9 +363,20 @@ class _Headless:
                     f"station capture cannot run {step.kind} steps yet (step {step.title!r})"
                 )
 
-    def _values_for(self, step: Any) -> dict[str, str]:
-        # _check_answerable made sure every required field has a value; the runner checks them.
-        return {f.name: self.inputs[f.name] for f in step.fields if f.name in self.inputs}
+
+def _print_stroke(outcome: Any) -> None:
+    """``stroke 7 A→B 412 points h=0.00123 v=0.00061 (LS straightness)``, once the stroke's
+    points are on disk (``on_stroke`` of the runner's stream)."""
+    from station.analysis.linearity import straightness
+
+    profile = outcome.profile
+    position = profile.get("s")
+    figures = " ".join(
+        f"{channel}={straightness(position, values).ls:.5f}"
+        for channel, values in profile.items()
+        if channel != "s" and position is not None and len(values) >= 2
+    )
+    print(f"{outcome.line()} {figures} (LS straightness)", flush=True)
 
 
 def _printer(notice: Any) -> None:
@@ -283,15 +403,23 @@ def run(args: argparse.Namespace) -> int:
 
     timeout = _positive(args.timeout, "--timeout")
     attempts = _positive(args.attempts, "--attempts", int)
-    inputs = _parse_inputs(args.input)
+    inputs = _parse_inputs(args.input, args.inputs)
+    deadband = _positive(args.deadband, "--deadband") if args.deadband else None
+    still = _positive(args.still, "--still")
     if args.resume:
         from station.session.model import load_session
 
         setup = _resume_setup(args)
-        done = set(load_session(args.resume, recover=False).confirmed_steps)
+        done = {
+            (event["step"], event.get("placement"))
+            for event in load_session(args.resume, recover=False).events
+            if event["type"] == "step"
+        }
     else:
         setup, done = _setup(args), set()
-    _check_answerable(setup.procedure, inputs, done)
+    from station.runner import plan_steps
+
+    _check_answerable(plan_steps(setup), setup.procedure, inputs, done)
 
     caught: list[int] = []
     previous = {}
@@ -317,7 +445,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"sessions folder: {folder} ({why})", flush=True)
             runner = Runner.start(setup, gauges, folder, listener=_printer)
         print(f"session file: {runner.path}", flush=True)
-        headless = _Headless(runner, inputs, timeout, attempts)
+        headless = _Headless(runner, inputs, timeout, attempts, deadband=deadband, still=still)
         worker = threading.Thread(target=headless.run, name="station capture", daemon=True)
         worker.start()
         while not headless.done.wait(0.05):
@@ -352,6 +480,19 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+_PROCEDURE_REPORTS = ("linearity", "relative_accuracy")
+"""Procedures whose report is their own (straightness, accuracy per placement), as
+``station analyze FILE`` prints it."""
+
+
+def _print_procedure_report(path: Path) -> None:
+    from station.commands import analyze
+
+    parser = argparse.ArgumentParser(prog="station")
+    analyze.add_parser(parser.add_subparsers())
+    analyze.run(parser.parse_args(["analyze", str(path)]))
+
+
 def _print_summary(runner: Any, analysis: Any) -> None:
     from station.analysis.report import format_report
 
@@ -361,7 +502,9 @@ def _print_summary(runner: Any, analysis: Any) -> None:
         f"Session file: {runner.path}",
         f"Last line hash (anchors the session file): {runner.last_hash}",
     ]
-    if analysis is not None:
+    if runner.setup.procedure.id in _PROCEDURE_REPORTS:
+        _print_procedure_report(runner.path)
+    elif analysis is not None:
         print(format_report(analysis, notes=notes), end="")
     else:
         print("no accepted cycles: nothing to analyse")

@@ -20,6 +20,23 @@ disconnects.
 
 Model options take one value for every channel or CH=V pairs, e.g. --bias x=0.002,y=-0.001.
 Fault rates are probabilities per frame sent.
+
+--model chooses the set-up (channels and unit follow from it for the two others):
+  fixture      one fixture, indicators x, y, z (repeatability; the default).
+  two-fixture  relative accuracy (report 2.8): x, y, z in inches. Each placement's second
+               fixture is where the teach pendant says (printed on stderr as "placement P:
+               the pendant reads X=... Y=... Z=... in" when the robot gets there); the
+               indicators at the first fixture read the return's error: --scale per unit moved,
+               --rotation (radians) about x, y, z, --noise. A protocol without a zero command is
+               zeroed in software, which reads one set at home per placement; the simulated
+               robot follows that order (one home reading, then the return).
+  bar          linearity (report 2.9): indicators h, v and the linear scale s in inches. The
+               robot shuttles A-B-A... along the bar (--length, --points per stroke, --dwell
+               readings at each end); h sees the bar's bow (--bow sagitta), v its sag (--sag),
+               both the path's wobble (--wobble, --wobble-v, --period). The indicators and the
+               scale's counter send every set by themselves at --push-rate sets per second
+               (default 200, as a counter's continuous output does): capture with
+               --trigger push. The robot advances one point per set sent.
 """
 
 
@@ -43,12 +60,19 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     where.add_argument("--pty", action="store_true", help="serve on a pseudo-terminal (default)")
     where.add_argument("--tcp", metavar="PORT", help="serve on TCP 127.0.0.1:PORT (0 = free)")
     parser.add_argument("--link", metavar="PATH", help="pty: also make PATH a symlink to it")
+    parser.add_argument(
+        "--model",
+        choices=("fixture", "two-fixture", "bar"),
+        default="fixture",
+        help="the set-up: fixture (repeatability, default), two-fixture (relative accuracy) or "
+        "bar (linearity)",
+    )
     parser.add_argument("--channels", default="x,y,z", help="station channels (default x,y,z)")
     parser.add_argument("--seed", default="0", help="random seed (default 0)")
     model = parser.add_argument_group("model (one value, or CH=V,... per channel)")
     for flag, default, text in (
         ("--bias", "0", "offset from nominal"),
-        ("--noise", "0.0005", "noise sigma"),
+        ("--noise", None, "noise sigma (0.0005; two-fixture 0.0002, bar 0.00005)"),
         ("--skew", "0", "skew-normal shape alpha (0 = normal)"),
         ("--drift", "0", "warm-up drift approached exponentially"),
         ("--drift-tau", "10", "warm-up time constant, in readings"),
@@ -56,8 +80,35 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         ("--outlier-rate", "0", "probability of an outlier per reading"),
     ):
         model.add_argument(flag, default=default, metavar="V", help=f"{text} (default {default})")
+    accuracy = parser.add_argument_group("two-fixture model (relative accuracy)")
+    accuracy.add_argument(
+        "--scale", default="x=2e-5,y=-1.5e-5,z=1e-5", metavar="V", help="scale error per unit moved"
+    )
+    accuracy.add_argument(
+        "--rotation", default="z=5e-6", metavar="V", help="rotation error, radians about x, y, z"
+    )
+    accuracy.add_argument(
+        "--reach", default="10,40", metavar="MIN,MAX", help="pendant coordinates' size (10,40)"
+    )
+    accuracy.add_argument(
+        "--preload", default="0.05", metavar="V", help="indicator preload spread at home (0.05)"
+    )
+    bar = parser.add_argument_group("bar model (linearity)")
+    for flag, default, text in (
+        ("--length", "20", "bar length A-B"),
+        ("--points", "400", "points per stroke while moving"),
+        ("--dwell", "20", "points at rest at each end"),
+        ("--bow", "0.0012", "bow of the bar (sagitta, seen by h)"),
+        ("--sag", "0.0006", "sag of the bar (sagitta, seen by v)"),
+        ("--wobble", "0.0004", "amplitude of the path's wobble on h"),
+        ("--wobble-v", "0.0002", "amplitude of the path's wobble on v"),
+        ("--period", "5", "period of the wobble along the bar"),
+    ):
+        bar.add_argument(flag, default=default, metavar="V", help=f"{text} (default {default})")
     gauge = parser.add_argument_group("gauge")
-    gauge.add_argument("--resolution", default="0.001", help="gauge resolution (0.001)")
+    gauge.add_argument(
+        "--resolution", help="gauge resolution (0.001; two-fixture and bar 0.0001 in)"
+    )
     gauge.add_argument("--unit", default="mm", choices=("mm", "in"), help="unit (mm)")
     gauge.add_argument("--range", default="-12.5,12.5", metavar="LOW,HIGH", help="gauge range")
     line = parser.add_argument_group("line and faults")
@@ -104,11 +155,75 @@ def _float(text: str, name: str) -> float:
         raise StationError(f"{name} {text!r} is not a number.") from None
 
 
+def _pair(text: str, name: str) -> tuple[float, float]:
+    try:
+        low, high = (float(v) for v in text.split(","))
+    except ValueError:
+        raise StationError(f"{name} {text!r}: give two numbers, e.g. {name} 10,40.") from None
+    return low, high
+
+
+def _procedure_model(args: argparse.Namespace, protocol, seed: int):
+    """The two-fixture or bar model the options describe (None for the fixture model)."""
+    from station.instruments.simulator import BarModel, GaugeSpec, TwoFixtureModel
+
+    if args.model == "fixture":
+        return None
+    resolution = positive_number(args.resolution, "--resolution")
+    if args.model == "two-fixture":
+        axes = ["x", "y", "z"]
+        scale = per_channel(args.scale, "--scale", axes)
+        rotation = per_channel(args.rotation, "--rotation", axes)
+        noise = per_channel(args.noise, "--noise", axes)
+        if len(set(noise.values())) != 1:
+            raise StationError("--noise: the two-fixture model takes one noise sigma for x, y, z.")
+        reach_min, reach_max = _pair(args.reach, "--reach")
+        # A software zero reads one set at home per placement; a device zero reads none.
+        home_readings = 0 if protocol.zero_command(protocol.channels[0]) else 1
+        return TwoFixtureModel(
+            scale=tuple(scale[a] for a in axes),
+            rotation=tuple(rotation[a] for a in axes),
+            noise=noise["x"],
+            reach_min=reach_min,
+            reach_max=reach_max,
+            home_readings=home_readings,
+            preload=_float(args.preload, "--preload"),
+            gauge=GaugeSpec(resolution, -0.5, 0.5, "in"),
+            seed=seed,
+        )
+    noise = per_channel(args.noise, "--noise", ["h", "v", "s"])
+    try:
+        points, dwell = int(args.points), int(args.dwell)
+    except ValueError:
+        raise StationError("--points and --dwell are whole numbers of readings.") from None
+    return BarModel(
+        length=_float(args.length, "--length"),
+        points=points,
+        dwell=dwell,
+        bow=_float(args.bow, "--bow"),
+        sag=_float(args.sag, "--sag"),
+        wobble=_float(args.wobble, "--wobble"),
+        wobble_v=_float(args.wobble_v, "--wobble-v"),
+        period=_float(args.period, "--period"),
+        noise=noise["h"],
+        indicator=GaugeSpec(resolution, -0.5, 0.5, "in"),
+    )
+
+
 def build_simulator(args: argparse.Namespace):
     """The :class:`~station.instruments.simulator.Simulator` the options describe."""
     from station.instruments.protocols import get_protocol
     from station.instruments.simulator import AxisModel, Faults, FixtureModel, GaugeSpec, Simulator
 
+    try:
+        seed = int(args.seed)
+    except ValueError:
+        raise StationError(f"--seed {args.seed!r} is not a whole number.") from None
+    protocol = get_protocol(args.protocol)
+    if args.resolution is None:
+        args.resolution = "0.001" if args.model == "fixture" else "0.0001"
+    if args.noise is None:
+        args.noise = {"fixture": "0.0005", "two-fixture": "0.0002", "bar": "0.00005"}[args.model]
     channels = [c.strip() for c in args.channels.split(",") if c.strip()]
     if not channels or len(set(channels)) != len(channels):
         raise StationError(f"--channels {args.channels!r}: name each channel once, e.g. x,y,z.")
@@ -127,7 +242,9 @@ def build_simulator(args: argparse.Namespace):
     except ValueError:
         raise StationError(f"--range {args.range!r}: give LOW,HIGH, e.g. -12.5,12.5.") from None
     resolution = positive_number(args.resolution, "--resolution")
-    model = FixtureModel(axes, GaugeSpec(resolution, low, high, args.unit))
+    model = _procedure_model(args, protocol, seed) or FixtureModel(
+        axes, GaugeSpec(resolution, low, high, args.unit)
+    )
     faults = Faults(
         garbage_rate=_float(args.garbage_rate, "--garbage-rate"),
         torn_rate=_float(args.torn_rate, "--torn-rate"),
@@ -137,21 +254,40 @@ def build_simulator(args: argparse.Namespace):
         disconnect_every=_float(args.disconnect_every, "--disconnect-every"),
         down_time=_float(args.down_time, "--down-time"),
     )
-    protocol = get_protocol(args.protocol)
-    if args.push_rate is None:
-        push_rate = 0.0 if protocol.polled else 1.0
-    else:
+    if args.push_rate is not None:
         push_rate = _float(args.push_rate, "--push-rate")
-    try:
-        seed = int(args.seed)
-    except ValueError:
-        raise StationError(f"--seed {args.seed!r} is not a whole number.") from None
+    elif args.model == "bar":
+        push_rate = 200.0
+    else:
+        push_rate = 0.0 if protocol.polled else 1.0
     return Simulator(protocol, model, faults, seed, push_rate=push_rate)
+
+
+def show_pendant(simulator) -> None:
+    """Print the teach pendant's display on stderr whenever the robot reaches another
+    placement (two-fixture model): the operator of a headless capture types it in."""
+    model = simulator.model
+    channels = tuple(simulator.channel_map.values())
+    shown = [0]
+
+    def on_sent(channel: str, k: int) -> None:
+        # The placement changes once every channel's reading of the last one is out.
+        sent = min(len(simulator.sent[c]) for c in channels)
+        number = model.current_placement(sent)
+        if number != shown[0]:
+            shown[0] = number
+            text = model.placement_of(number).pendant_text()
+            print(f"placement {number}: the pendant reads {text}", file=sys.stderr, flush=True)
+
+    on_sent("", 0)
+    simulator.on_sent = on_sent
 
 
 def run(args: argparse.Namespace) -> int:
     """Print the URL, serve until SIGINT/SIGTERM."""
     simulator = build_simulator(args)
+    if args.model == "two-fixture":
+        show_pendant(simulator)
     done = threading.Event()
     previous = signal.signal(signal.SIGTERM, lambda *_: done.set())
     try:

@@ -638,6 +638,10 @@ class GaugeSet:
             raise error  # GaugeReader reports it as a status message
 
     def _add_to_push_set(self, reading: GaugeReading) -> CaptureResult | None:
+        if not self._pending and len(self.readers) == 1 and reading.channel != self.channels[0]:
+            # One port sends a set as a burst in its channels' order: a set starts with the
+            # first, so the tail of a burst cut by arm() never joins the next burst's head.
+            return None
         if reading.channel in self._pending:
             self._pending_duplicated.add(reading.channel)
             return None

@@ -38,7 +38,7 @@ import threading
 import time
 import tty
 from collections import deque
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -100,6 +100,11 @@ class RobotModel:
     def value(self, channel: str, k: int, seed: int) -> float:
         """What ``channel``'s gauge shows for its ``k``-th reading (0-based), for ``seed``."""
         raise NotImplementedError
+
+    def zero_reference(self, channel: str, k_next: int, seed: int) -> float:
+        """What the gauge shows when its zero key is pressed before its ``k_next``-th reading:
+        by default the last value it showed (the first one before any)."""
+        return self.value(channel, max(k_next - 1, 0), seed)
 
 
 def _skew_normal_unit(alpha: float, z0: float, z1: float) -> float:
@@ -285,6 +290,9 @@ class Simulator:
         """Per channel, the value the gauge showed when its zero command came (then subtracted)."""
         self.dropped_bytes = 0
         self.disconnects = 0
+        self.on_sent: Callable[[str, int], object] | None = None
+        """Called (server thread, lock held; must not block) after the k-th reading of a
+        channel is sent: ``station simulate`` shows the pendant display as placements change."""
         self._k = dict.fromkeys(self.channel_map.values(), 0)
         self._fault_rng = random.Random(f"faults/{seed}")
         self._recent: deque[bytes] = deque(maxlen=16)
@@ -622,6 +630,10 @@ class Simulator:
                 for device in self.channel_map:
                     if not silent:
                         self._send_reading(device, can_be_silent=False)
+                # A set is one instant: a channel whose frame was lost (a full pty, nobody
+                # reading) skips that instant too, so the channels never drift apart.
+                latest = max(self._k.values())
+                self._k = dict.fromkeys(self._k, latest)
 
     def stale_burst(self, count: int | None = None) -> None:
         """Send copies of the last ``count`` frames again now (old frames delivered late)."""
@@ -690,6 +702,8 @@ class Simulator:
             return  # the line is down: this value was never seen, and k is not used up
         self._k[channel] = k + 1
         self.sent[channel].append(SentFrame(channel, k, value, frame, time.monotonic()))
+        if self.on_sent is not None:
+            self.on_sent(channel, k)
         if stale and self._recent:
             self._write(b"".join(list(self._recent)[-faults.stale_count :]))
         self._recent.append(frame)
@@ -707,8 +721,7 @@ class Simulator:
     def _zero(self, channel: str) -> None:
         """The device's zero key: what it shows now (its last reading) becomes 0."""
         self.zero_requests.append(channel)
-        last = self.sent[channel][-1].k if self.sent[channel] else 0
-        self.zero_offsets[channel] = self.model.value(channel, last, self.seed)
+        self.zero_offsets[channel] = self.model.zero_reference(channel, self._k[channel], self.seed)
 
     def sent_values(self, channel: str) -> list[float]:
         """The values sent so far on ``channel``, in order."""
@@ -755,9 +768,18 @@ class TwoFixtureModel(RobotModel):
     (``rotation``, radians about x, y, z: the error ω × P), both growing with the distance moved,
     plus a constant ``bias`` and repeatability ``noise`` (σ) per reading.
 
-    ``captures`` readings are taken per placement; the k-th reading belongs to placement
-    ``k // captures + 1`` unless :attr:`placement` is set (a runner or the autopilot that knows
-    which placement it is at). :meth:`placement_of` gives the pendant display to type in.
+    Each placement is ``home_readings`` readings at home (the indicators show their preload,
+    seeded per placement and axis within ±``preload``, plus noise) followed by ``captures``
+    readings after the return (preload + error + noise); the k-th reading belongs to placement
+    ``k // (home_readings + captures) + 1`` unless :attr:`placement` is set (a runner or the
+    autopilot that knows which placement it is at). :meth:`placement_of` gives the pendant
+    display to type in.
+
+    Zeroing at the first fixture must take out the preload and nothing else: a software zero
+    reads the home readings (so a procedure run with a software-zero protocol wants
+    ``home_readings=1``: its zero step reads one set per placement); a device zero
+    (:meth:`zero_reference`) takes the placement's preload itself, with no reading
+    (``home_readings=0``). Either way the capture after the return shows the placement's error.
     """
 
     channels = ("x", "y", "z")
@@ -772,6 +794,8 @@ class TwoFixtureModel(RobotModel):
         reach_min: float = 10.0,
         reach_max: float = 40.0,
         captures: int = 1,
+        home_readings: int = 0,
+        preload: float = 0.0,
         pendant_resolution: float = 0.001,
         gauge: GaugeSpec = GaugeSpec(0.0001, -0.5, 0.5, "in"),
         seed: int = 0,
@@ -785,7 +809,11 @@ class TwoFixtureModel(RobotModel):
         self.bias = tuple(float(v) for v in bias)
         self.noise = float(noise)
         self.reach = (float(reach_min), float(reach_max))
+        if home_readings < 0 or preload < 0:
+            raise StationError("home readings and the preload must not be negative.")
         self.captures = int(captures)
+        self.home_readings = int(home_readings)
+        self.preload = float(preload)
         self.pendant_resolution = float(pendant_resolution)
         self._gauge = gauge
         self.seed = seed
@@ -819,17 +847,40 @@ class TwoFixtureModel(RobotModel):
             for b, s, p, r in zip(self.bias, self.scale, (px, py, pz), rotated, strict=True)
         )
 
+    @property
+    def readings_per_placement(self) -> int:
+        """Readings of each channel per placement: at home, then after the return."""
+        return self.home_readings + self.captures
+
     def current_placement(self, k: int) -> int:
         """The placement of the k-th reading."""
-        return self.placement if self.placement is not None else k // self.captures + 1
+        if self.placement is not None:
+            return self.placement
+        return k // self.readings_per_placement + 1
+
+    def at_home(self, k: int) -> bool:
+        """True when the k-th reading is taken at home (before the round trip)."""
+        return k % self.readings_per_placement < self.home_readings
+
+    def preload_of(self, number: int) -> tuple[float, float, float]:
+        """How far the cube depresses each indicator at placement ``number``, about its mid
+        travel (what zeroing at the first fixture takes out)."""
+        rng = random.Random(f"preload/{self.seed}/{number}")
+        return tuple(rng.uniform(-self.preload, self.preload) for _ in range(3))  # type: ignore[return-value]
 
     def true_value(self, channel: str, k: int, seed: int) -> float:
         """The indicator's reading before quantisation and clipping."""
         index = self.channels.index(channel)
         rng = random.Random(f"{seed}/{index}/{k}")
-        return self.systematic_error(self.current_placement(k))[index] + self.noise * rng.gauss(
-            0.0, 1.0
-        )
+        number = self.current_placement(k)
+        error = 0.0 if self.at_home(k) else self.systematic_error(number)[index]
+        return self.preload_of(number)[index] + error + self.noise * rng.gauss(0.0, 1.0)
+
+    def zero_reference(self, channel: str, k_next: int, seed: int) -> float:
+        """A device zero at the first fixture takes the placement's preload: the robot is at
+        home, so the indicator shows no error there."""
+        number = self.current_placement(k_next)
+        return self._gauge.show(self.preload_of(number)[self.channels.index(channel)])
 
     def value(self, channel: str, k: int, seed: int) -> float:
         """The k-th displayed reading of ``channel``."""

@@ -1,0 +1,187 @@
+"""Linearity end to end: ``station capture --procedure linearity`` against ``station simulate
+--model bar`` (both real processes on a real pty), then ``station verify`` and ``station analyze
+FILE --json`` on the session file."""
+
+from __future__ import annotations
+
+import json
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from station.instruments.simulator import BarModel
+from station.session.model import load_session
+
+STATION = [sys.executable, "-m", "station"]
+SEED = 5
+BAR = {"points": 100, "dwell": 6, "bow": 0.0015, "sag": 0.0008, "noise": 0.00002}
+STROKES = 25
+
+
+def start_bar(*extra: str) -> tuple[subprocess.Popen, str]:
+    """``station simulate --model bar`` pushing 500 sets a second; returns it and its URL."""
+    process = subprocess.Popen(
+        [
+            *STATION,
+            "simulate",
+            "--protocol",
+            "mitutoyo",
+            "--model",
+            "bar",
+            "--seed",
+            str(SEED),
+            "--push-rate",
+            "500",
+            *(f"--{key}={value}" for key, value in BAR.items()),
+            *extra,
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    url = process.stdout.readline().strip()
+    if not url:
+        process.kill()
+        pytest.fail(f"the simulator gave no URL: {process.communicate()[1]}")
+    return process, url
+
+
+def stop(process: subprocess.Popen) -> None:
+    process.send_signal(signal.SIGTERM)
+    process.communicate(timeout=10)
+
+
+def capture(url: str, folder: Path, *extra: str) -> subprocess.Popen:
+    return subprocess.Popen(
+        [
+            *STATION,
+            "capture",
+            "--procedure",
+            "linearity",
+            "--port",
+            url,
+            "--protocol",
+            "mitutoyo",
+            "--robot",
+            "KSC-7",
+            "--operator",
+            "tester",
+            "--trigger",
+            "push",
+            "--strokes",
+            str(STROKES),
+            "--sessions",
+            str(folder),
+            *extra,
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def analyze_json(path: Path) -> dict:
+    done = subprocess.run(
+        [*STATION, "analyze", str(path), "--json"], capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
+def verify(path: Path) -> None:
+    done = subprocess.run([*STATION, "verify", str(path)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout + done.stderr
+
+
+def streamed_points(path: Path) -> list[list[float]]:
+    """Every point of the stroke step, in the order it was written."""
+    return [list(row) for batch in load_session(path).samples for row in batch.values]
+
+
+def assert_contiguous(path: Path) -> None:
+    """No point was dropped or torn apart: the recorded (h, v, s) points are the simulator's
+    k-th sets for consecutive k, each set one instant (the model gives what it sent)."""
+    session = load_session(path)
+    model = BarModel(**BAR)
+    offsets = {
+        channel: spec["offset"]
+        for channel, spec in session.zeroes[-1]["channels"].items()  # the last zero
+    }
+    points = streamed_points(path)
+    channels = session.samples[0].channels
+
+    def shown(channel: str, k: int) -> float:
+        # The device shows its reading; the station subtracts the software zero's offset.
+        return model.value(channel, k, SEED) - offsets[channel]
+
+    def point_is(i: int, k: int) -> bool:
+        return all(abs(points[i][c] - shown(name, k)) < 1e-7 for c, name in enumerate(channels))
+
+    # The stream began wherever the robot was: find that k, then every later point follows.
+    start = next((k for k in range(20_000) if all(point_is(i, k + i) for i in range(40))), None)
+    assert start is not None, "the first points are not consecutive sets of the simulator"
+    wrong = next((i for i in range(len(points)) if not point_is(i, start + i)), None)
+    assert wrong is None, f"point {wrong} is missing, repeated or mixes two sets"
+
+
+def test_a_linearity_session_streams_every_point_and_recovers_the_bar(tmp_path: Path) -> None:
+    simulator, url = start_bar()
+    try:
+        process = capture(url, tmp_path)
+        out, err = process.communicate(timeout=60)
+    finally:
+        stop(simulator)
+    assert process.returncode == 0, err
+    lines = [line for line in out.splitlines() if line.startswith("stroke ")]
+    assert len(lines) == STROKES
+    assert re.fullmatch(
+        r"stroke 1 (A→B|B→A) \d+ points h=\d\.\d{5} v=\d\.\d{5} \(LS straightness\)", lines[0]
+    )
+    directions = [line.split()[2] for line in lines]
+    assert all(a != b for a, b in zip(directions, directions[1:], strict=False))
+    path = next(tmp_path.glob("*.jsonl"))
+    verify(path)
+    assert_contiguous(path)
+
+    document = analyze_json(path)
+    linearity = document["linearity"]
+    assert len(linearity["strokes"]) == STROKES
+    for stroke in linearity["strokes"]:
+        # The bow is seen by h, the sag by v; the bar model's wobble adds at most its p-v.
+        assert stroke["h"]["mz"] == pytest.approx(BAR["bow"], abs=0.0004 * 2 + 0.00015)
+        assert stroke["v"]["mz"] == pytest.approx(BAR["sag"], abs=0.0002 * 2 + 0.00015)
+
+
+def test_sigterm_mid_stream_then_resume_continues_the_strokes(tmp_path: Path) -> None:
+    simulator, url = start_bar()
+    try:
+        process = capture(url, tmp_path)
+        seen = []
+        deadline = time.monotonic() + 30
+        while len(seen) < 8 and time.monotonic() < deadline:
+            line = process.stdout.readline()
+            if line.startswith("stroke "):
+                seen.append(line)
+        process.send_signal(signal.SIGTERM)
+        out, err = process.communicate(timeout=20)
+        assert process.returncode == 143, err
+        path = next(tmp_path.glob("*.jsonl"))
+        assert load_session(path).status == "interrupted"
+        acknowledged = len(seen) + sum(1 for line in out.splitlines() if line.startswith("stroke "))
+
+        resumed = capture(url, tmp_path, "--resume", str(path))
+        out, err = resumed.communicate(timeout=60)
+    finally:
+        stop(simulator)
+    assert resumed.returncode == 0, err
+    numbers = [int(line.split()[1]) for line in out.splitlines() if line.startswith("stroke ")]
+    # The numbering continues after the strokes acknowledged before the signal.
+    assert numbers == list(range(acknowledged + 1, STROKES + 1))
+    verify(path)
+    document = analyze_json(path)
+    assert len(document["linearity"]["strokes"]) == STROKES

@@ -1,0 +1,226 @@
+"""Relative accuracy end to end: the runner against the two-fixture simulator on a real pty, and
+``station capture`` against ``station simulate --model two-fixture`` (real processes); the
+analysis of the session file (``station analyze FILE --json``) recovers the simulator's scale
+error per axis and keeps the pendant coordinates with each placement."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from station.instruments.protocols import get_protocol
+from station.instruments.simulator import GaugeSpec, Simulator, TwoFixtureModel
+from station.procedures import discover_procedures
+from station.runner import PortSetup, Runner, SessionSetup
+from station.session.model import load_session
+
+STATION = [sys.executable, "-m", "station"]
+SCALE = (2.0e-5, -1.5e-5, 1.0e-5)
+NOISE = 0.0001
+PLACEMENTS = 8
+DEVICE_MAP = {"1": "x", "2": "y", "3": "z"}
+
+
+def model(seed: int) -> TwoFixtureModel:
+    """The simulator's model: mitutoyo has no zero command, so the station zeroes in software
+    and reads one set at home per placement."""
+    return TwoFixtureModel(
+        scale=SCALE,
+        rotation=(0.0, 0.0, 0.0),
+        noise=NOISE,
+        home_readings=1,
+        preload=0.05,
+        gauge=GaugeSpec(0.0001, -0.5, 0.5, "in"),
+        seed=seed,
+    )
+
+
+def analyze_json(path: Path) -> dict:
+    done = subprocess.run(
+        [*STATION, "analyze", str(path), "--json"], capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
+def assert_recovers(path: Path, seed: int) -> None:
+    """The file's analysis gives the configured scale error per axis, the pendant of every
+    placement, and each placement's error near the model's."""
+    done = subprocess.run([*STATION, "verify", str(path)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout + done.stderr
+    accuracy = analyze_json(path)["accuracy"]
+    truth = model(seed)
+    assert [p["placement"] for p in accuracy["placements"]] == list(range(1, PLACEMENTS + 1))
+    for placement in accuracy["placements"]:
+        number = placement["placement"]
+        expected = truth.placement_of(number).pendant
+        assert placement["pendant"] == dict(zip("xyz", expected, strict=True))
+        error = truth.systematic_error(number)
+        for axis, value in zip("xyz", error, strict=True):
+            # One capture per placement: the error within 5 sigma of the two readings' noise
+            # (the software zero's home reading and the capture).
+            assert placement["mean"][axis] == pytest.approx(value, abs=5 * NOISE * 2**0.5)
+    for axis, scale in zip("xyz", SCALE, strict=True):
+        assert accuracy["axes"][axis]["scale_error"] == pytest.approx(scale, abs=6e-6)
+
+
+def test_the_runner_walks_relative_accuracy_against_the_two_fixture_simulator(
+    tmp_path: Path, gauges_for
+) -> None:
+    seed = 11
+    simulator = Simulator(get_protocol("mitutoyo"), model(seed), seed=seed)
+    url = simulator.start_pty()
+    try:
+        procedure = discover_procedures(use_env=False).get("relative_accuracy")
+        setup = SessionSetup(
+            procedure=procedure,
+            robot="KSC-7",
+            operator="tester",
+            ports=(PortSetup(url, "mitutoyo", DEVICE_MAP),),
+            placements=PLACEMENTS,
+        )
+        runner = Runner.start(setup, gauges_for(setup), tmp_path)
+        while (state := runner.state()).current is not None:
+            step = state.current
+            if step.kind == "check":
+                runner.confirm()
+            elif step.kind == "zero":
+                runner.zero()
+            elif step.kind == "input":
+                # The operator reads the pendant of this placement (the autopilot's way).
+                pendant = simulator.model.placement_of(step.placement).pendant
+                runner.submit_input({a: str(v) for a, v in zip("xyz", pendant, strict=True)})
+            else:
+                assert runner.capture(5.0).recorded
+        runner.finish()
+    finally:
+        simulator.stop()
+    session = load_session(runner.path)
+    assert [c.placement for c in session.cycles.values()] == list(range(1, PLACEMENTS + 1))
+    assert len(session.zeroes) == PLACEMENTS
+    assert_recovers(runner.path, seed)
+
+
+def write_inputs(path: Path, seed: int) -> Path:
+    """What the operator copies from the pendant: one row per placement."""
+    rows = ["placement,x,y,z"]
+    for number in range(1, PLACEMENTS + 1):
+        x, y, z = model(seed).placement_of(number).pendant
+        rows.append(f"{number},{x},{y},{z}")
+    path.write_text("\n".join(rows) + "\n")
+    return path
+
+
+def start_two_fixture(seed: int) -> tuple[subprocess.Popen, str]:
+    process = subprocess.Popen(
+        [
+            *STATION,
+            "simulate",
+            "--protocol",
+            "mitutoyo",
+            "--model",
+            "two-fixture",
+            "--seed",
+            str(seed),
+            "--scale",
+            ",".join(f"{a}={v}" for a, v in zip("xyz", SCALE, strict=True)),
+            "--rotation",
+            "0",
+            "--noise",
+            str(NOISE),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    url = process.stdout.readline().strip()
+    if not url:
+        process.kill()
+        pytest.fail(f"the simulator gave no URL: {process.communicate()[1]}")
+    return process, url
+
+
+def capture_args(url: str, folder: Path, inputs: Path) -> list[str]:
+    return [
+        *STATION,
+        "capture",
+        "--procedure",
+        "relative_accuracy",
+        "--port",
+        url,
+        "--protocol",
+        "mitutoyo",
+        "--robot",
+        "KSC-7",
+        "--operator",
+        "tester",
+        "--placements",
+        str(PLACEMENTS),
+        "--inputs",
+        str(inputs),
+        "--sessions",
+        str(folder),
+    ]
+
+
+def test_station_capture_against_station_simulate_two_fixture(tmp_path: Path) -> None:
+    seed = 4
+    inputs = write_inputs(tmp_path / "pendant.csv", seed)
+    simulator, url = start_two_fixture(seed)
+    try:
+        done = subprocess.run(
+            capture_args(url, tmp_path / "sessions", inputs),
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+    finally:
+        simulator.send_signal(signal.SIGTERM)
+        _, shown = simulator.communicate(timeout=10)
+    assert done.returncode == 0, done.stderr
+    assert sum(line.startswith("cycle ") for line in done.stdout.splitlines()) == PLACEMENTS
+    assert "RELATIVE ACCURACY REPORT" in done.stdout
+    # The simulator showed each placement's pendant as the robot got there.
+    first = model(seed).placement_of(1).pendant_text()
+    assert f"placement 1: the pendant reads {first}" in shown
+    assert f"placement {PLACEMENTS}: the pendant reads" in shown
+    path = next((tmp_path / "sessions").glob("*.jsonl"))
+    assert_recovers(path, seed)
+
+
+@pytest.mark.parametrize(
+    ("extra", "fault"),
+    [
+        (["--input", "x=1", "--input", "y=2"], "asks for z: pass --input 1:z=VALUE"),
+        (["--input", "0:x=1"], "the placement before ':' must be 1, 2, 3"),
+        (["--input", "2:q=1"], "asks for x, y, z"),
+    ],
+)
+def test_missing_or_bad_pendant_values_are_refused_before_anything_is_written(
+    tmp_path: Path, extra: list[str], fault: str
+) -> None:
+    args = [
+        *STATION,
+        "capture",
+        "--procedure",
+        "relative_accuracy",
+        "--port",
+        "/dev/null-no-such-port",
+        "--protocol",
+        "mitutoyo",
+        "--robot",
+        "R",
+        "--sessions",
+        str(tmp_path),
+        *extra,
+    ]
+    done = subprocess.run(args, capture_output=True, text=True, timeout=30)
+    assert done.returncode == 2
+    assert fault in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
+    assert not list(tmp_path.glob("*.jsonl"))
