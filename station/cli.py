@@ -18,10 +18,23 @@ from station import __version__
 from station.errors import StationError
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The full argument parser, with every module of :mod:`station.commands` registered."""
+def command_names() -> list[str]:
+    """The sub-commands: one per public module of :mod:`station.commands`, sorted."""
     import station.commands as commands_package
 
+    return sorted(
+        info.name
+        for info in pkgutil.iter_modules(commands_package.__path__)
+        if not info.name.startswith("_")
+    )
+
+
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser with every sub-command registered, or just ``only``.
+
+    Registering one command imports only its module: the TUI and each command start without
+    loading the others (``station --help`` and a mistyped command still see them all).
+    """
     parser = argparse.ArgumentParser(
         prog="station",
         description=(
@@ -32,12 +45,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"station {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
-    modules = sorted(
-        info.name
-        for info in pkgutil.iter_modules(commands_package.__path__)
-        if not info.name.startswith("_")
-    )
-    for name in modules:
+    for name in [only] if only else command_names():
         importlib.import_module(f"station.commands.{name}").add_parser(subparsers)
     return parser
 
@@ -51,7 +59,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not arguments or (arguments[0].startswith("-") and arguments[0] not in _TOP_LEVEL_FLAGS):
         # The bare command (or only options such as --no-mouse) opens the TUI.
         arguments = ["tui", *arguments]
-    parser = build_parser()
+    known = arguments[0] in command_names()
+    parser = build_parser(only=arguments[0] if known else None)
     args = parser.parse_args(arguments)
     try:
         return int(args.func(args) or 0)
