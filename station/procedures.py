@@ -14,6 +14,9 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
     channels = ["x", "y", "z"]
     unit = "in"                     # "in" or "mm"
     resolution = 0.0001             # the gauge's resolution in `unit`
+    analysis = "repeatability"      # optional: repeatability, relative_accuracy or linearity;
+                                    # default by the steps: a stroke step -> linearity, a repeat
+                                    # block -> relative_accuracy, else repeatability
 
     [cycles]                        # optional; default min 25, target 30 (the report's 25 to 30)
     min = 25
@@ -59,6 +62,9 @@ from station.errors import StationError
 StepKind = Literal["check", "input", "zero", "capture", "cycles", "stroke", "repeat"]
 STEP_KINDS: tuple[str, ...] = ("check", "input", "zero", "capture", "cycles", "stroke", "repeat")
 UNITS: tuple[str, ...] = ("in", "mm")
+AnalysisKind = Literal["repeatability", "relative_accuracy", "linearity"]
+ANALYSIS_KINDS: tuple[str, ...] = ("repeatability", "relative_accuracy", "linearity")
+"""How a procedure's sessions are analysed (``station analyze``, the summary)."""
 DEFAULT_CYCLES_MIN = 25
 DEFAULT_CYCLES_TARGET = 30
 PROCEDURES_ENV = "STATION_PROCEDURES"
@@ -135,6 +141,8 @@ class Procedure:
     steps: tuple[Step, ...]
     path: Path
     sha256: str
+    analysis: AnalysisKind = "repeatability"
+    """How its sessions are analysed: the file's ``analysis``, else by its steps."""
 
     def all_steps(self) -> Iterator[Step]:
         """Every step in file order, including those inside repeat blocks (after their block)."""
@@ -298,6 +306,7 @@ _TOP_KEYS = (
     "channels",
     "unit",
     "resolution",
+    "analysis",
     "cycles",
     "limits",
     "steps",
@@ -372,6 +381,7 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
     steps = tuple(
         _parse_step(context, raw, str(index)) for index, raw in enumerate(raw_steps, start=1)
     )
+    analysis = _analysis_kind(check, table.get("analysis"), steps, channels)
     return Procedure(
         id=procedure_id,
         title=title,
@@ -387,7 +397,34 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
         steps=steps,
         path=path,
         sha256=hashlib.sha256(data).hexdigest(),
+        analysis=analysis,
     )
+
+
+def _analysis_kind(
+    check: _Checker, declared: Any, steps: tuple[Step, ...], channels: tuple[str, ...]
+) -> AnalysisKind:
+    """The declared analysis kind, checked against what the steps record; else the default."""
+    kinds = {step.kind for step in steps} | {inner.kind for step in steps for inner in step.steps}
+    if declared is None:
+        if "stroke" in kinds:
+            return "linearity"
+        return "relative_accuracy" if "repeat" in kinds else "repeatability"
+    if declared not in ANALYSIS_KINDS:
+        raise check.fail(
+            "", f"'analysis' must be one of {', '.join(ANALYSIS_KINDS)}, not {declared!r}"
+        )
+    # The linearity analysis reads streamed strokes; relative accuracy, captures per placement.
+    if declared == "linearity" and "stroke" not in kinds:
+        raise check.fail("", "'analysis' linearity needs a stroke step (streamed strokes)")
+    if declared == "relative_accuracy":
+        if "repeat" not in kinds:
+            raise check.fail(
+                "", "'analysis' relative_accuracy needs a repeat block (one per placement)"
+            )
+        if not {"x", "y", "z"} <= set(channels):
+            raise check.fail("", "'analysis' relative_accuracy needs the channels x, y and z")
+    return declared
 
 
 def _parse_limits(

@@ -22,11 +22,18 @@ lives anywhere else. The runner never imports a UI. Its rules:
 
 Threads: every public method may be called from any thread. A lock serialises journal writes
 and state changes; blocking waits on the instruments happen outside it, so :meth:`interrupt`
-(from a signal handler's thread) never waits for a capture timeout. With the ``push`` trigger,
-completed reading sets arrive on the reader's thread and are queued to the runner's own recorder
-thread (so the reader keeps draining the line while the disk syncs); they become cycles while
-the ``cycles`` or ``capture`` step that was current when they arrived still is, the runner is
-not paused, and the step does not have its count yet.
+(from a signal handler's thread) never waits for a capture timeout. Whatever arrives on a
+reader's thread (a completed ``push`` set, a port's state change) is queued, without the lock,
+to the runner's own intake thread, which writes it (so the reader keeps draining the line while
+the disk syncs). A push set becomes a cycle while the ``cycles`` or ``capture`` step that was
+current when it arrived still is, the runner is not paused, and the step does not have its count
+yet. A capture, zero or stroke records only into the step it was started in: confirming a
+``cycles`` step waits until the capture under way ends.
+
+A resumed session puts the recorded zero back on the gauges (each channel's last ``zero``
+event), so cycles after the resume are zeroed like those before it. A failed write (a full
+disk) makes the runner ``failed``; every later action raises the journal's own sentence
+(:attr:`Runner.failure`).
 
 The listener receives a :class:`RunnerNotice` after every event is on disk (and for messages
 that are not in the file), on whichever thread produced it; it must not block. Alarms: the live
@@ -46,19 +53,17 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from station.errors import StationError
 from station.instruments.base import SerialSettings
+from station.instruments.gauge import TRIGGERS, Trigger, unit_mismatch
 
 if TYPE_CHECKING:
     from station.analysis.summary import Analysis
     from station.procedures import Procedure, Step
-
-Trigger = Literal["poll", "push", "stable"]
-TRIGGERS: tuple[str, ...] = ("poll", "push", "stable")
 
 StepMark = Literal["done", "current", "pending"]
 
@@ -73,6 +78,26 @@ CAPTURE_BY = "station capture"
 """The ``by`` recorded when the headless command confirms a step itself."""
 
 _MESSAGES_KEPT = 20
+
+
+def value_decimals(resolution: float | None) -> int:
+    """How many decimals a gauge of ``resolution`` shows (0.0001 -> 4, 0.0005 -> 4, 0.002 -> 3,
+    1e-05 -> 5); 5 when the resolution is unknown."""
+    if resolution is None or not math.isfinite(resolution) or resolution <= 0:
+        return 5
+    from decimal import Decimal
+
+    exponent = Decimal(repr(float(resolution))).normalize().as_tuple().exponent
+    return max(0, -int(exponent))
+
+
+def format_value(value: float, resolution: float | None) -> str:
+    """A reading as the gauge shows it: signed, at its resolution's decimals (``+0.0012``).
+
+    Rounding to the display is what the operator reads; the file keeps the full value."""
+    text = f"{value:+.{value_decimals(resolution)}f}"
+    # -0.00004 at four decimals would read "-0.0000": a zero has no sign worth showing.
+    return "+" + text[1:] if text.startswith("-") and not text.strip("-0.") else text
 
 
 @dataclass(frozen=True)
@@ -208,6 +233,7 @@ class SessionSetup:
                 "id": self.procedure.id,
                 "version": self.procedure.version,
                 "sha256": self.procedure.sha256,
+                "analysis": self.procedure.analysis,
             },
             "robot": self.robot,
             "operator": self.operator,
@@ -282,11 +308,15 @@ class CycleRecord:
     placement: int | None
     rejected: str | None = None
     """The reason when the cycle was rejected afterwards."""
+    resolution: float | None = None
+    """The session's gauge resolution: :meth:`line` shows that many decimals."""
 
     def line(self) -> str:
-        """The one-line form ``cycle 7 x=+0.00012 y=-0.00003 z=+0.00001``."""
+        """The one-line form ``cycle 7 x=+0.0012 y=-0.0003 z=+0.0001`` (values at the
+        resolution's decimals, :func:`format_value`)."""
         return f"cycle {self.cycle} " + " ".join(
-            f"{channel}={value:+.5f}" for channel, value in self.values.items()
+            f"{channel}={format_value(value, self.resolution)}"
+            for channel, value in self.values.items()
         )
 
 
@@ -298,6 +328,9 @@ class CycleOutcome:
     recorded: bool
     message: str
     cycle: CycleRecord | None = None
+    port_down: bool = False
+    """Refused only because a port was down for the whole wait (the line is reconnecting):
+    not the gauges refusing a set, so a caller counting refusals should not count it."""
 
 
 @dataclass(frozen=True)
@@ -355,6 +388,9 @@ class RunnerState:
     """How many strokes the current ``stroke`` step asks for (0 outside one)."""
     stroke_points: int = 0
     """Points streamed so far in the stroke under way (0 when none is)."""
+    failure: str = ""
+    """Why the session failed (status ``failed``: a write failed, e.g. the disk is full);
+    empty otherwise."""
 
     @property
     def accepted(self) -> int:
@@ -407,6 +443,24 @@ def _procedure_limits(procedure: Procedure) -> dict[str, Any]:
     }
 
 
+def header_limits(header: Mapping[str, Any]) -> dict[str, Any]:
+    """The spec limits a session header records, as a
+    :class:`~station.analysis.capability.SpecLimits` per channel it measures; a channel with
+    neither an LSL nor a USL has none."""
+    from station.analysis.capability import SpecLimits
+
+    channels = header.get("channels")
+    return {
+        str(channel): SpecLimits(
+            lsl=spec.get("lsl"), usl=spec.get("usl"), nominal=spec.get("nominal")
+        )
+        for channel, spec in dict(header.get("limits") or {}).items()
+        if (channels is None or channel in channels)
+        and isinstance(spec, Mapping)
+        and (spec.get("lsl") is not None or spec.get("usl") is not None)
+    }
+
+
 def analysis_config(header: Mapping[str, Any]) -> Any:
     """The :class:`~station.analysis.summary.AnalysisConfig` a session header implies: its
     limits, resolution, unit, rule set and threshold (single readings, subgroup 1).
@@ -414,20 +468,11 @@ def analysis_config(header: Mapping[str, Any]) -> Any:
     The live analysis of a running session and the batch analysis of its file are both built
     from this, so the two agree.
     """
-    from station.analysis.capability import SpecLimits
     from station.analysis.summary import AnalysisConfig
 
-    channels = list(header.get("channels") or ())
-    limits = {
-        channel: SpecLimits(lsl=spec.get("lsl"), usl=spec.get("usl"), nominal=spec.get("nominal"))
-        for channel, spec in dict(header.get("limits") or {}).items()
-        if channel in channels
-        and isinstance(spec, Mapping)
-        and (spec.get("lsl") is not None or spec.get("usl") is not None)
-    }
     resolution = header.get("resolution")
     return AnalysisConfig(
-        limits=limits,
+        limits=header_limits(header),
         resolution=float(resolution) if isinstance(resolution, int | float) else None,
         unit=str(header.get("unit") or ""),
         rule_set=str(header.get("rules") or "report"),
@@ -443,15 +488,8 @@ def setup_from_header(
 ) -> SessionSetup:
     """The set-up a session header records, to resume it. ``ports`` replaces the recorded
     ports (a USB adapter that came back under another name)."""
-    from station.analysis.capability import SpecLimits
-
     instruments = dict(header.get("instruments") or {})
     recorded_ports = tuple(PortSetup.from_header(p) for p in instruments.get("ports") or ())
-    limits = {
-        channel: SpecLimits(lsl=spec.get("lsl"), usl=spec.get("usl"), nominal=spec.get("nominal"))
-        for channel, spec in dict(header.get("limits") or {}).items()
-        if spec.get("lsl") is not None or spec.get("usl") is not None
-    }
     cycles = header.get("cycles_target")
     placements, strokes = header.get("placements_target"), header.get("strokes_target")
     return SessionSetup(
@@ -462,7 +500,7 @@ def setup_from_header(
         trigger=instruments.get("trigger", "poll"),
         unit=str(header["unit"]),
         resolution=float(header["resolution"]) if header.get("resolution") else None,
-        limits=limits,
+        limits=header_limits(header),
         cycles=int(cycles) if isinstance(cycles, int) else None,
         rule_set=str(header.get("rules") or "report"),
         threshold=float(header.get("threshold") or 1.0),
@@ -577,6 +615,16 @@ class Runner:
         # by an interruption) keep their own numbers, so numbers never repeat.
         self._stroke_numbers: dict[tuple[str, int | None], int] = {}
         self._stream_queue: queue.SimpleQueue[Any] | None = None
+        # Hands the stream queue over between a streamed stroke and the reader thread, so a
+        # push set never waits for the runner's lock (the step position and the busy flag are
+        # read there as single attributes).
+        self._intake_lock = threading.Lock()
+        self._claimed_position = -1
+        # The last zero event's entry per channel ({"method", "offset"}), kept on resume.
+        self._recorded_zero: dict[str, dict[str, Any]] = {}
+        self._failure: str | None = None
+        self._intake: queue.SimpleQueue[tuple[Any, ...] | None] | None = None
+        self._hooked: list[tuple[Any, Any, Any]] = []
         self._warned_position = -1
         self._stroke_points = 0
         self._stroke_stop = threading.Event()
@@ -639,6 +687,7 @@ class Runner:
         try:
             runner = cls(setup, gauges, writer, listener=listener)
             runner._replay(session)
+            device_zeroed = runner._restore_zero()
         except BaseException:
             writer.close()  # release the file's lock: the session stays resumable
             raise
@@ -646,6 +695,13 @@ class Runner:
         runner._attach("when the session resumed")
         if session.torn is not None:
             runner._say("warning", session.torn.message)
+        if device_zeroed:
+            runner._say(
+                "warning",
+                f"{', '.join(device_zeroed)} {'was' if len(device_zeroed) == 1 else 'were'} "
+                "zeroed by the gauges' own command: if they were switched off since, they no "
+                "longer are. Check that they read zero at the zero position before going on.",
+            )
         if setup.procedure.sha256 != session.header["procedure"]["sha256"]:
             runner._say(
                 "warning",
@@ -669,6 +725,9 @@ class Runner:
                     item = self._plan[self._position]
                     if item.key == (event["step"], event.get("placement")):
                         self._position += 1
+                elif kind == "zero":
+                    for channel, zeroed in dict(event.get("channels") or {}).items():
+                        self._recorded_zero[str(channel)] = dict(zeroed)
                 elif kind == "alarm":
                     self._alarm_count += 1
                     key = (str(event.get("channel")), str(event.get("rule")))
@@ -682,6 +741,7 @@ class Runner:
                         step_id=cycle.step,
                         placement=cycle.placement,
                         rejected=session.rejected.get(number),
+                        resolution=self.setup.resolved_resolution,
                     )
                 )
             self._next_cycle = session.next_cycle
@@ -699,82 +759,125 @@ class Runner:
             self._rebuild_live()
             self._views = ()
 
+    def _restore_zero(self) -> list[str]:
+        """Put the recorded zero back on the gauges (a resumed session may run on a fresh
+        gauge set, whose readers know no offset): each channel's software offset from its last
+        ``zero`` event, 0.0 for a device zero. Returns the channels the device zeroed (their
+        zero lives in the gauge, which may have been power-cycled)."""
+        offsets = {
+            channel: float(zeroed.get("offset") or 0.0)
+            if zeroed.get("method") == "software"
+            else 0.0
+            for channel, zeroed in self._recorded_zero.items()
+            if channel in getattr(self.gauges, "channels", ())
+        }
+        if offsets:
+            self.gauges.set_zero_offsets(offsets)
+        return [c for c, zeroed in self._recorded_zero.items() if zeroed.get("method") == "device"]
+
     # -- callbacks from the instruments ---------------------------------------------------------
 
     def _attach(self, moment: str) -> None:
-        if getattr(self.gauges, "trigger", None) == "push":
-            self._push_sets: queue.SimpleQueue[tuple[int, Any] | None] = queue.SimpleQueue()
-            threading.Thread(
-                target=self._record_push_sets, name="runner push recorder", daemon=True
-            ).start()
-            self.gauges.on_set = self._on_push_set
-        for reader in getattr(self.gauges, "readers", ()):
-            previous = reader.on_status
-            self._port_states[reader.url] = reader.state
+        """Start the intake thread, hook the gauges' set and status callbacks (undone by
+        :meth:`_close`) and record how each line stands now. On failure everything is undone
+        and the file closed."""
+        self._intake: queue.SimpleQueue[tuple[Any, ...] | None] = queue.SimpleQueue()
+        self._intake_thread = threading.Thread(
+            target=self._take_in, name="runner intake", daemon=True
+        )
+        self._intake_thread.start()
+        self._hooked: list[tuple[Any, Any, Any]] = []
+        try:
+            if getattr(self.gauges, "trigger", None) == "push":
+                self.gauges.on_set = self._on_push_set
+            for reader in getattr(self.gauges, "readers", ()):
+                previous = reader.on_status
+                self._port_states[reader.url] = reader.state
 
-            def chained(status: Any, previous: Any = previous) -> None:
-                if previous is not None:
-                    previous(status)
-                self._on_port_status(status)
+                def chained(status: Any, previous: Any = previous) -> None:
+                    if previous is not None:
+                        previous(status)
+                    self._on_port_status(status)
 
-            reader.on_status = chained
-        with self._lock:
-            # The file says how each line stood when the session (re)started; changes follow.
-            for url, state in self._port_states.items():
-                self._append("instrument", port=url, state=state, message=moment)
+                reader.on_status = chained
+                self._hooked.append((reader, previous, chained))
+            with self._lock:
+                # The file says how each line stood when the session (re)started; changes
+                # follow.
+                for url, state in self._port_states.items():
+                    self._append("instrument", port=url, state=state, message=moment)
+        except BaseException:
+            with self._lock:
+                self._close()
+            raise
 
     def _on_port_status(self, status: Any) -> None:
-        with self._lock:
-            if status.state == self._port_states.get(status.port):
-                return
-            self._port_states[status.port] = status.state
-            if self._status in ("running", "paused") and status.state in (
-                "connected",
-                "disconnected",
-            ):
-                self._append(
-                    "instrument", port=status.port, state=status.state, message=status.message
-                )
-                level: MessageLevel = "info" if status.state == "connected" else "warning"
-                self._say(level, f"{status.port}: {status.state} ({status.message})")
+        """A port's state changed, on its reader's thread: handed to the intake thread, which
+        writes the ``instrument`` event (the reader never waits for the disk)."""
+        self._intake.put(("status", status))
+
+    def _record_port_status(self, status: Any) -> None:
+        """The intake side of :meth:`_on_port_status`. Lock held."""
+        if status.state == self._port_states.get(status.port):
+            return
+        self._port_states[status.port] = status.state
+        if self._status in ("running", "paused") and status.state in (
+            "connected",
+            "disconnected",
+        ):
+            self._append("instrument", port=status.port, state=status.state, message=status.message)
+            level: MessageLevel = "info" if status.state == "connected" else "warning"
+            self._say(level, f"{status.port}: {status.state} ({status.message})")
 
     def _on_push_set(self, result: Any) -> None:
-        """A completed push set, on the reader's thread: note when it came, hand it over.
+        """A completed push set, on the reader's thread: note which step was current and hand
+        it over, without the runner's lock.
 
-        Recording (an fsync, the live figures) happens on the runner's own thread, so the
-        reader keeps draining the line while the disk works."""
-        with self._lock:
-            if self._stream_queue is not None:
-                self._stream_queue.put(result)  # a streamed stroke takes every set, in order
-                return
-            if self._busy or self._status != "running":
-                return  # a software zero is taking this set, or the session is not running
-            if not self._capture_step():
-                # Said once per step: a streaming device sends many sets a second.
-                if self._warned_position != self._position:
-                    self._warned_position = self._position
-                    self._say(
-                        "warning",
-                        "Reading sets arrive while no capture step is current; they are not "
-                        "recorded.",
-                    )
-                return
-            position = self._position
-        self._push_sets.put((position, result))
+        Recording (an fsync, the live figures, the alarms) happens on the intake thread, so
+        the reader keeps draining the line while the disk works and never waits for a
+        capture, a zero or a write under way."""
+        with self._intake_lock:
+            stream = self._stream_queue
+            position, busy = self._position, self._busy
+        if stream is not None:
+            stream.put(result)  # a streamed stroke takes every set, in order
+            return
+        self._intake.put(("set", position, busy, result))
 
-    def _record_push_sets(self) -> None:
-        """The push recorder thread: records queued sets in order until the runner closes."""
+    def _take_in(self) -> None:
+        """The intake thread: records queued push sets and port changes, in order, until the
+        runner closes."""
         while True:
-            queued = self._push_sets.get()
+            queued = self._intake.get()
             if queued is None:
                 return
-            position, result = queued
             with self._lock:
-                if self._status != "running" or position != self._position:
-                    continue  # the session or the step moved on since the set arrived
-                # A failed write is already the operator's message and the runner's status.
+                if self._writer.closed:
+                    continue  # closed while this waited: the file takes nothing more
+                # A failed write is already the operator's message and the runner's failure.
                 with contextlib.suppress(StationError):
-                    self._record(result, by="operator")
+                    if queued[0] == "status":
+                        self._record_port_status(queued[1])
+                    else:
+                        self._record_push_set(*queued[1:])
+
+    def _record_push_set(self, position: int, busy: bool, result: Any) -> None:
+        """Record a push set as a cycle if the step current when it arrived still is. Lock
+        held."""
+        if busy or self._status != "running" or position != self._position:
+            # A software zero took this set, the session is not running, or the step moved on
+            # since the set arrived.
+            return
+        if not self._capture_step():
+            # Said once per step: a streaming device sends many sets a second.
+            if self._warned_position != self._position:
+                self._warned_position = self._position
+                self._say(
+                    "warning",
+                    "Reading sets arrive while no capture step is current; they are not recorded.",
+                )
+            return
+        self._record(result, by="operator", position=position)
 
     # -- operator actions -----------------------------------------------------------------------
 
@@ -790,6 +893,10 @@ class Runner:
                 self._complete_step(item, by)
                 return
             elif kind == "cycles":
+                if self._busy:
+                    # The set being taken belongs to this step: going on now would file it
+                    # under the next one.
+                    raise StationError("a capture is under way: wait for it to end")
                 done = self._step_accepted(item)
                 target, minimum = self._cycle_counts(item)
                 if done < minimum:
@@ -867,16 +974,21 @@ class Runner:
             )
             self._complete_step(item, by)
 
-    def zero(self, by: str = "operator") -> None:
+    def zero(self, by: str = "operator", timeout: float = 5.0) -> None:
         """Zero the current ``zero`` step's channels (the device's command, else a software
-        offset from a fresh reading set), record a ``zero`` event and complete the step."""
+        offset from a fresh reading set), record a ``zero`` event and complete the step.
+
+        A port that is down is waited for until ``timeout``; a gauge reading in another unit
+        than the session's is refused (nothing zeroed)."""
         with self._lock:
             item = self._current_item()
             if item.step.kind != "zero":
                 raise StationError(f"step {item.step.title!r} is not a zero step")
             self._claim()
         try:
-            results = self.gauges.zero(list(item.step.channels))
+            results = self.gauges.zero(
+                list(item.step.channels), timeout, unit=self.setup.resolved_unit
+            )
         except StationError as error:
             with self._lock:
                 self._busy = False
@@ -924,6 +1036,8 @@ class Runner:
                         f"No reading set arrived within {timeout:g} s: press DATA on the "
                         "gauges (or check the cable)."
                     )
+                if self._status == "failed":
+                    self._ensure_open()  # raises the failure's own sentence
                 if self._status != "running" or self._last_outcome is None:
                     return self._refuse(f"The session is {self._status}; nothing recorded.")
                 return self._last_outcome
@@ -936,7 +1050,7 @@ class Runner:
             raise
         with self._lock:
             self._busy = False
-            return self._record(result, by=by)
+            return self._record(result, by=by, position=self._claimed_position)
 
     def stroke(
         self,
@@ -1046,7 +1160,8 @@ class Runner:
             self._stroke_stop.clear()
             pushed = self.setup.trigger == "push"
             if pushed:
-                self._stream_queue = queue.SimpleQueue()
+                with self._intake_lock:
+                    self._stream_queue = queue.SimpleQueue()
         channels = list(item.step.channels)
         scale = channels.index(item.step.direction_channel)
         target, _ = self._stroke_counts(item)
@@ -1122,7 +1237,8 @@ class Runner:
                 flush(last=True)  # a segment still open: recorded, without the end mark
         finally:
             with self._lock:
-                self._stream_queue = None
+                with self._intake_lock:
+                    self._stream_queue = None
                 self._busy = False
                 self._stroke_points = 0
         if skipped:
@@ -1205,9 +1321,7 @@ class Runner:
             index = accepted[-1]
             record = self._cycles[index]
             self._append("reject", cycle=record.cycle, reason=reason, by=by)
-            self._cycles[index] = CycleRecord(
-                record.cycle, record.values, record.step_id, record.placement, reason
-            )
+            self._cycles[index] = replace(record, rejected=reason)
             self._rebuild_live()
             self._say("info", f"Cycle {record.cycle} rejected: {reason}.")
             self._notify(None)
@@ -1287,6 +1401,13 @@ class Runner:
         return Path(self._writer.path)
 
     @property
+    def failure(self) -> str | None:
+        """Why the session failed (a write failed: the journal's sentence, e.g. a full disk),
+        or ``None``. The session file keeps everything acknowledged before it."""
+        with self._lock:
+            return self._failure
+
+    @property
     def last_hash(self) -> str:
         """The sha256 of the file's last line (print it: it anchors the file)."""
         return str(self._writer.last_hash)
@@ -1294,8 +1415,6 @@ class Runner:
     def analysis(self) -> Analysis:
         """The analysis of the accepted cycles so far: equal to the batch ``analyze`` of the
         session file (rejected cycles excluded). StationError before the first cycle."""
-        from dataclasses import replace
-
         with self._lock:
             snapshot = self._live.snapshot()
             rejected = tuple(r.cycle for r in self._cycles if r.rejected is not None)
@@ -1332,6 +1451,7 @@ class Runner:
                 strokes=self._strokes.get(item.key, 0) if stroke_item else 0,
                 strokes_target=self._stroke_counts(item)[0] if stroke_item else 0,
                 stroke_points=self._stroke_points,
+                failure=self._failure or "",
             )
 
     def prompt(self) -> str:
@@ -1358,7 +1478,7 @@ class Runner:
         self._live = self._new_live()
         for record in self._cycles:
             if record.rejected is None:
-                self._live.add_set(record.values)
+                self._live.add_set(record.values, record.cycle)
 
     def _current_item(self) -> _PlanItem:
         self._ensure_open()
@@ -1373,13 +1493,18 @@ class Runner:
         return item if item.step.kind in ("capture", "cycles") else None
 
     def _ensure_open(self) -> None:
+        if self._status == "failed" and self._failure:
+            raise StationError(self._failure)
         if self._status in ("finished", "interrupted", "failed"):
             raise StationError(f"the session is {self._status}: {self.path}")
 
     def _claim(self) -> None:
+        """Mark a capture, zero or stroke under way, and the step it belongs to: its result
+        is recorded only while that step is still current. Lock held."""
         if self._busy:
             raise StationError("a capture or zero is already under way: wait for it")
         self._busy = True
+        self._claimed_position = self._position
 
     def _cycle_counts(self, item: _PlanItem) -> tuple[int, int]:
         """(target, minimum) accepted cycles for a cycles step; the set-up's count applies to
@@ -1459,10 +1584,15 @@ class Runner:
         self._say("warning", message)
         return CycleOutcome(recorded=False, message=message)
 
-    def _record(self, result: Any, by: str) -> CycleOutcome:
-        """Record a reading set as the next cycle if it is whole and fresh. Lock held."""
+    def _record(self, result: Any, by: str, position: int | None = None) -> CycleOutcome:
+        """Record a reading set as the next cycle if it is whole and fresh, and (``position``)
+        the step it was taken for is still current. Lock held."""
         if self._status != "running":
             return self._refuse(f"The session is {self._status}; the reading set was not recorded.")
+        if position is not None and position != self._position:
+            return self._refuse(
+                "The step changed while the reading set was taken; it was not recorded."
+            )
         item = self._capture_step()
         if item is None:
             return self._refuse("No capture step is current; the reading set was not recorded.")
@@ -1476,6 +1606,8 @@ class Runner:
             )
         elif problem:
             outcome = self._refuse(f"Not recorded: {problem} Capture again.")
+            if getattr(result, "port_down", False):
+                outcome = replace(outcome, port_down=True)
         else:
             outcome = self._write_cycle(item, {ch: result.readings[ch] for ch in needed}, by)
         self._last_outcome = outcome
@@ -1510,6 +1642,7 @@ class Runner:
             values={channel: float(r.value) for channel, r in readings.items()},
             step_id=item.step.id,
             placement=item.placement,
+            resolution=self.setup.resolved_resolution,
         )
         self._cycles.append(record)
         self._accepted_by_step[item.key] = self._accepted_by_step.get(item.key, 0) + 1
@@ -1517,7 +1650,7 @@ class Runner:
         # Acknowledged: the listener hears of the reading as soon as it is on disk, with the
         # state that includes it; the live figures and alarms follow.
         self._notify(self._last_event)
-        self._record_alarms(self._live.add_set(record.values))
+        self._record_alarms(self._live.add_set(record.values, number))
         if item.step.kind == "capture":
             self._complete_step(item, by)
         elif item.step.kind == "cycles":
@@ -1547,8 +1680,8 @@ class Runner:
                 self._record_alarm(channel, alarm)
 
     def _record_alarm(self, channel: str, alarm: Any) -> None:
-        accepted = [r.cycle for r in self._cycles if r.rejected is None and channel in r.values]
-        cycles = [accepted[p - 1] for p in alarm.points if 0 < p <= len(accepted)]
+        # The live analysis is fed each set with its cycle number: its alarms name cycles.
+        cycles = list(alarm.cycles)
         if not cycles:
             return
         flagged = self._alarm_flagged.setdefault((channel, alarm.rule), set())
@@ -1576,6 +1709,7 @@ class Runner:
         except StationError as error:
             if self._writer.closed:
                 self._status = "failed"
+                self._failure = error.message
                 self._say("error", error.message)
                 self._outcome_ready.notify_all()
             raise
@@ -1585,10 +1719,18 @@ class Runner:
         return event
 
     def _close(self) -> None:
+        """Close the file and let go of the gauges: their callbacks are put back as they were
+        (a gauge set resumed on again and again never grows a chain of dead runners) and the
+        intake thread ends."""
         self._writer.close()
         if getattr(self.gauges, "on_set", None) == self._on_push_set:
             self.gauges.on_set = None
-            self._push_sets.put(None)
+        for reader, previous, chained in self._hooked:
+            if reader.on_status is chained:
+                reader.on_status = previous
+        self._hooked = []
+        if self._intake is not None:
+            self._intake.put(None)
 
     def _say(self, level: MessageLevel, text: str) -> None:
         message = OperatorMessage(level, text)
@@ -1612,8 +1754,10 @@ def _set_problem(result: Any, needed: Sequence[str], unit: str) -> str:
     or duplicated, or in another unit than the session's."""
     problems = []
     missing = [c for c in needed if c not in result.readings]
-    stale = [c for c in missing if c in result.stale]
-    absent = [c for c in missing if c not in stale]
+    down = set(getattr(result, "disconnected", ()))
+    stale = [c for c in missing if c in result.stale and c not in down]
+    # A channel whose port is down is explained by the port's own sentence (in errors).
+    absent = [c for c in missing if c not in stale and c not in down]
     if absent:
         problems.append("no reading from " + ", ".join(absent))
     if stale:
@@ -1621,15 +1765,15 @@ def _set_problem(result: Any, needed: Sequence[str], unit: str) -> str:
     duplicated = [c for c in needed if c in result.duplicated]
     if duplicated:
         problems.append("more than one reading from " + ", ".join(duplicated))
-    other_unit = [
-        f"{c} reads in {result.readings[c].unit}"
-        for c in needed
-        if c in result.readings and result.readings[c].unit != unit
-    ]
-    if other_unit:
-        problems.append(", ".join(other_unit) + f" but the session is in {unit}")
+    mismatch = unit_mismatch(result.readings, needed, unit)
+    if mismatch:
+        problems.append(mismatch)
     if missing and result.errors:
-        problems.extend(result.errors)
+        # A port's sentence may end in a full stop already; this one ends the whole list.
+        problems.extend(error.rstrip(". ") for error in result.errors)
+    elif down & set(missing):
+        unexplained = [c for c in missing if c in down]
+        problems.append(f"the port of {', '.join(unexplained)} is disconnected (reconnecting...)")
     return "; ".join(problems) + "." if problems else ""
 
 

@@ -25,7 +25,7 @@ from collections.abc import Sequence
 
 from station.analysis.capability import Capability, SpecLimits
 from station.analysis.descriptive import Descriptive
-from station.analysis.rules import Alarm
+from station.analysis.rules import Alarm, number_list
 
 #: |a₁| at or above this is "close to 1 or higher" (report §2.7.1).
 SKEW_HINT = 0.8
@@ -37,12 +37,11 @@ def _figure(value: float, unit: str) -> str:
     return f"{value:+.3g} {unit}".rstrip()
 
 
-def _points(points: Sequence[int]) -> str:
-    if len(points) == 1:
-        return f"point {points[0]}"
-    if len(points) > 2 and points[-1] - points[0] == len(points) - 1:
-        return f"points {points[0]}-{points[-1]}"
-    return "points " + ", ".join(str(p) for p in points)
+def _where(alarm: Alarm) -> str:
+    """Where an alarm looks: its cycles when known ("cycle 7", "cycles 6 to 9"), else its
+    chart points."""
+    numbers, word = (alarm.cycles, "cycle") if alarm.cycles else (alarm.points, "point")
+    return f"{word}{'s' if len(numbers) > 1 else ''} {number_list(numbers)}"
 
 
 def offset_is_clear(descriptive: Descriptive, nominal: float) -> bool:
@@ -102,7 +101,7 @@ def channel_hints(
             "has shifted off nominal; re-centre it (re-teach or compensate the offset)."
         )
     if alarms:
-        fired = "; ".join(f"{alarm.rule} at {_points(alarm.points)}" for alarm in alarms[:6])
+        fired = "; ".join(f"{alarm.rule} at {_where(alarm)}" for alarm in alarms[:6])
         more = f"; and {len(alarms) - 6} more" if len(alarms) > 6 else ""
         hints.append(
             f"{name}: the control chart shows a pattern ({fired}{more}); look at those cycles "

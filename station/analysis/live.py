@@ -37,6 +37,12 @@ would have to re-judge old points whenever a limit crosses them. We split the jo
 
 So the dashboard reads ``snapshot()`` (once per redraw, O(n) in numpy, as drawing the chart
 is anyway) and the journal records ``add()``'s alarms as they happen.
+
+**Cycle numbers.** ``add(value, cycle)`` labels each reading with its cycle number (the
+default is its position, 1, 2, 3 ...). The alarms of ``add()`` and of ``snapshot()`` list the
+cycles they flag in ``Alarm.cycles`` and name them in their sentences, exactly as the batch
+:func:`summary.analyze` given the same cycle numbers: a runner that skipped a rejected cycle
+records "Cycle 7 is above ..." for the 6th accepted reading without translating positions.
 """
 
 from __future__ import annotations
@@ -50,7 +56,13 @@ from station.analysis.charts import LARGEST_RANGE_SUBGROUP, chart_type
 from station.analysis.constants import SIGMA_MULTIPLE, chart_factors
 from station.analysis.descriptive import step_multiple
 from station.analysis.rules import Alarm, check_rules
-from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis, combine
+from station.analysis.summary import (
+    Analysis,
+    AnalysisConfig,
+    ChannelAnalysis,
+    combine,
+    point_cycles,
+)
 
 #: The longest window any rule looks back over (15 points: report rule 3, Nelson 7).
 RULE_WINDOW = 15
@@ -104,6 +116,7 @@ class LiveChannel:
         self.config = config
         self.limits: SpecLimits | None = config.limits_for(name)
         self._values: list[float] = []
+        self._cycles: list[int] = []
         # Moments of the readings minus the first one: readings far from 0 (an indicator not
         # zeroed) would otherwise lose digits in the running mean.
         self._origin = 0.0
@@ -138,8 +151,14 @@ class LiveChannel:
         """A copy of the readings in the order they were added."""
         return list(self._values)
 
-    def add(self, value: float) -> LiveUpdate:
-        """Add one reading (a finite number) and return the updated figures."""
+    @property
+    def cycles(self) -> list[int]:
+        """A copy of the readings' cycle numbers, in the order they were added."""
+        return list(self._cycles)
+
+    def add(self, value: float, cycle: int | None = None) -> LiveUpdate:
+        """Add one reading (a finite number) of cycle number ``cycle`` (default: its position,
+        1, 2, 3 ...) and return the updated figures."""
         x = float(value)
         if not math.isfinite(x):
             from station.errors import StationError
@@ -149,6 +168,7 @@ class LiveChannel:
             )
         previous = self._values[-1] if self._values else None
         self._values.append(x)
+        self._cycles.append(len(self._values) if cycle is None else int(cycle))
         self._snapshot = None
         n = len(self._values)
 
@@ -283,13 +303,19 @@ class LiveChannel:
         """Alarms flagging the newest point, from the windows it completes (O(RULE_WINDOW))."""
         tail = self._points[-RULE_WINDOW:]
         newest = len(self._points)
+        first = newest - len(tail) + 1
+        # The cycles behind the tail's points only: O(RULE_WINDOW · subgroup), not O(n).
+        behind = point_cycles(
+            self._cycles[(first - 1) * self._subgroup :], self._subgroup, len(tail)
+        )
         alarms = check_rules(
             tail,
             center,
             sigma,
             self.config.rule_set,
             unit=self.config.unit or None,
-            first_point=newest - len(tail) + 1,
+            first_point=first,
+            cycles=behind,
         )
         return tuple(alarm for alarm in alarms if newest in alarm.points)
 
@@ -302,7 +328,7 @@ class LiveChannel:
                 from station.errors import StationError
 
                 raise StationError(f"channel {self.name!r} has no readings yet.")
-            self._snapshot = analyze_channel(self.name, self._values, self.config)
+            self._snapshot = analyze_channel(self.name, self._values, self.config, self._cycles)
         return self._snapshot
 
 
@@ -321,13 +347,17 @@ class LiveAnalysis:
             self.channels[name] = LiveChannel(name, self.config)
         return self.channels[name]
 
-    def add(self, name: str, value: float) -> LiveUpdate:
-        """Add one reading of channel ``name``."""
-        return self.channel(name).add(value)
+    def add(self, name: str, value: float, cycle: int | None = None) -> LiveUpdate:
+        """Add one reading of channel ``name`` (of cycle number ``cycle``, see
+        :meth:`LiveChannel.add`)."""
+        return self.channel(name).add(value, cycle)
 
-    def add_set(self, readings: Mapping[str, float]) -> dict[str, LiveUpdate]:
-        """Add one cycle's reading set (channel → value)."""
-        return {name: self.add(name, value) for name, value in readings.items()}
+    def add_set(
+        self, readings: Mapping[str, float], cycle: int | None = None
+    ) -> dict[str, LiveUpdate]:
+        """Add one cycle's reading set (channel → value); ``cycle`` is its number, so alarms
+        name cycles (default: each channel's reading count)."""
+        return {name: self.add(name, value, cycle) for name, value in readings.items()}
 
     def snapshot(self) -> Analysis:
         """The whole analysis so far (channels with readings): equal to the batch ``analyze``."""

@@ -77,11 +77,18 @@ def _wrap(text: str, width: int, indent: str = "") -> list[str]:
     ) or [indent.rstrip()]
 
 
-def format_readings(readings: Sequence[float], decimals: int, width: int = 80) -> list[str]:
-    """The numbered readings in three PIECE / MEASUREMENT column pairs, down then across."""
+def format_readings(
+    readings: Sequence[float],
+    decimals: int,
+    width: int = 80,
+    cycles: Sequence[int] | None = None,
+) -> list[str]:
+    """The readings in three PIECE / MEASUREMENT column pairs, down then across; a piece is
+    its cycle number (``cycles``; 1, 2, 3 ... when None), so a rejected cycle leaves a gap."""
     n = len(readings)
+    pieces = list(range(1, n + 1)) if cycles is None else list(cycles)
     rows = math.ceil(n / 3)
-    piece_width = max(5, len(str(n)))
+    piece_width = max(5, max((len(str(p)) for p in pieces), default=1))
     measure_width = max(11, max((len(signed(v, decimals)) for v in readings), default=0))
     pair = piece_width + 2 + measure_width
     gap = max(2, min(6, (width - 3 * pair) // 2))
@@ -94,7 +101,7 @@ def format_readings(readings: Sequence[float], decimals: int, width: int = 80) -
             i = column * rows + row
             if i < n:
                 cells.append(
-                    f"{i + 1:>{piece_width}}  {signed(readings[i], decimals):>{measure_width}}"
+                    f"{pieces[i]:>{piece_width}}  {signed(readings[i], decimals):>{measure_width}}"
                 )
         lines.append(header.join(cells))
     return lines
@@ -199,7 +206,7 @@ def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int 
         percent = 100.0 * count / n if n else 0.0
         lines.append(f"PIECES {side} SPEC: {count}   PERCENT {side} SPEC: {percent:.2f}")
     lines.append("")
-    lines += format_readings(channel.readings, decimals, width)
+    lines += format_readings(channel.readings, decimals, width, channel.cycles or None)
     lines.append("")
     lines.append(f"HISTOGRAM (bin width {channel.histogram.bin_width:g})")
     lines += format_histogram(channel.histogram, limits, decimals, width, channel.nominal)

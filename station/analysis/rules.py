@@ -28,13 +28,15 @@ The report (§2.7.4) lists four signs without defining them further. Our reading
 
 Alarms: one :class:`Alarm` per rule per contiguous run of flagged points on the same side;
 ``points`` lists every flagged point of that run (1-based), ``text`` is a sentence for the
-technician.
+technician. Given the cycle numbers behind each point (``cycles``), an alarm also lists them and,
+when each point is one cycle (single readings), its sentence names the cycles ("Cycle 7 is above
+..."): after a rejected cycle, the 6th point is cycle 7.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -55,6 +57,8 @@ class Alarm:
     rule: str
     points: tuple[int, ...]
     text: str
+    cycles: tuple[int, ...] = ()
+    """The cycle numbers behind the flagged points, ascending (empty when the caller gave none)."""
 
 
 # A rule's flags: one boolean array per direction (+1 above/rising, -1 below/falling, 0 none).
@@ -182,19 +186,18 @@ class _Kind:
     pattern: Pattern | None  # None: the beyond-the-limits rule, which has its own sentence
     advice: str = ""
 
-    def text(self, run: list[int], side: int, ctx: _Context, fmt: Formatter) -> str:
-        """The alarm sentence for a run of flagged points on one side."""
-        plural = len(run) > 1
+    def text(self, subject: str, plural: bool, side: int, ctx: _Context, fmt: Formatter) -> str:
+        """The alarm sentence for a run of flagged points on one side, named by ``subject``."""
         if self.pattern is None:
             limit = ctx.center + 3 * ctx.sigma * side
             return (
-                f"{_subject(run)} {'are' if plural else 'is'} {_side_word(side)} the "
+                f"{subject} {'are' if plural else 'is'} {_side_word(side)} the "
                 f"{'upper' if side > 0 else 'lower'} control limit ({fmt(limit)}): "
                 f"look for a cause at {'those cycles' if plural else 'that cycle'}."
             )
         advice = self.advice.format(direction="up" if side > 0 else "down")
         verb = "each end" if plural else "completes"
-        return f"{_subject(run)} {verb} {self.pattern(side, ctx, fmt)}: {advice}."
+        return f"{subject} {verb} {self.pattern(side, ctx, fmt)}: {advice}."
 
 
 def _zone_pattern(k: int, m: int, multiple: int) -> Pattern:
@@ -365,6 +368,28 @@ def _subject(points: list[int]) -> str:
     return f"Points {points[0]} to {points[-1]}"
 
 
+def number_list(numbers: Sequence[int]) -> str:
+    """Ascending numbers as words, consecutive runs of three or more joined: ``7``, ``7 and 9``,
+    ``2, 4 to 6 and 8``."""
+    runs: list[list[int]] = []
+    for number in numbers:
+        if runs and number == runs[-1][-1] + 1:
+            runs[-1].append(number)
+        else:
+            runs.append([number])
+    parts: list[str] = []
+    for run in runs:
+        if len(run) >= 3:
+            parts.append(f"{run[0]} to {run[-1]}")
+        else:
+            parts.extend(str(n) for n in run)
+    return parts[0] if len(parts) == 1 else ", ".join(parts[:-1]) + " and " + parts[-1]
+
+
+def _cycle_subject(cycles: Sequence[int]) -> str:
+    return f"{'Cycle' if len(cycles) == 1 else 'Cycles'} {number_list(cycles)}"
+
+
 def _contiguous(indices: np.ndarray) -> list[list[int]]:
     """Split sorted 0-based indices into runs of consecutive ones, as 1-based point numbers."""
     groups: list[list[int]] = []
@@ -384,6 +409,7 @@ def check_rules(
     *,
     unit: str | None = None,
     first_point: int = 1,
+    cycles: Sequence[Sequence[int]] | None = None,
 ) -> list[Alarm]:
     """Every alarm of the rule set on the plotted points, ordered by first point then rule.
 
@@ -392,9 +418,17 @@ def check_rules(
     nothing to check and the list is empty. ``unit`` is appended to the values in the text.
     ``first_point`` is the chart number of ``points[0]``: the live form checks only the last
     window of a long chart and still names the points as the chart numbers them.
+    ``cycles`` gives, for each of ``points`` in order, the cycle numbers behind it (one for
+    single readings, a subgroup's for subgroup means): each alarm then lists them in
+    ``cycles``, and names the cycles in its sentence when every point is one cycle.
     """
     rules = _rules_of(rule_set)
     values = as_readings(points, what="point")
+    if cycles is not None and len(cycles) != values.size:
+        raise StationError(
+            f"{len(cycles)} cycle labels were given for {values.size} chart points: "
+            "give one per point"
+        )
     if center is None or sigma is None or values.size == 0:
         return []
     if not (math.isfinite(center) and math.isfinite(sigma)) or sigma < 0:
@@ -410,7 +444,14 @@ def check_rules(
     for order, (rule_id, kind) in enumerate(rules):
         for side, flags in kind.check(ctx).items():
             for run in _contiguous(np.flatnonzero(flags) + (first_point - 1)):
-                text = kind.text(run, side, ctx, fmt)
-                found.append((run[0], order, Alarm(rule_id, tuple(run), text)))
+                labels: tuple[int, ...] = ()
+                subject = _subject(run)
+                if cycles is not None:
+                    behind = [cycles[p - first_point] for p in run]
+                    labels = tuple(sorted({int(c) for group in behind for c in group}))
+                    if all(len(group) == 1 for group in behind):
+                        subject = _cycle_subject(labels)
+                text = kind.text(subject, len(run) > 1, side, ctx, fmt)
+                found.append((run[0], order, Alarm(rule_id, tuple(run), text, labels)))
     found.sort(key=lambda item: (item[0], item[1]))
     return [alarm for _, _, alarm in found]

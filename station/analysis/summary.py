@@ -7,6 +7,10 @@ and the verdict hints. :func:`to_json` turns the result into the documented JSON
 Run rules are checked on the location chart (individuals or subgroup means) against its own
 centre line and sigma, ``(UCL − centre)/3``; the dispersion chart's limits are reported, not
 rule-checked.
+
+Readings are labelled by their cycle numbers (``cycles``): a session that rejected cycle 3 has
+cycle 7 as its 6th reading, and the report, the alarms and the hints name cycle 7. Without
+labels the readings are cycles 1, 2, 3 ... in order.
 """
 
 from __future__ import annotations
@@ -80,7 +84,7 @@ class AnalysisConfig:
 
 @dataclass(frozen=True)
 class ChannelAnalysis:
-    """Everything computed for one channel, plus its readings in order."""
+    """Everything computed for one channel, plus its readings in order and their cycles."""
 
     name: str
     descriptive: Descriptive
@@ -91,6 +95,8 @@ class ChannelAnalysis:
     readings: tuple[float, ...]
     limits: SpecLimits | None
     nominal: float
+    cycles: tuple[int, ...] = ()
+    """The cycle number of each reading (same order); the alarms' ``cycles`` come from it."""
 
 
 @dataclass(frozen=True)
@@ -139,8 +145,30 @@ def undefined_capability(
     )
 
 
-def chart_alarms(chart: ControlChart, rule_set: str, unit: str = "") -> tuple[Alarm, ...]:
-    """The run-rule alarms of a chart's location points.
+def point_cycles(cycles: Sequence[int], subgroup: int, points: int) -> list[tuple[int, ...]]:
+    """The cycle numbers behind each of the first ``points`` chart points: one cycle per point
+    for single readings, the ``subgroup`` consecutive cycles of each subgroup mean."""
+    return [tuple(cycles[i * subgroup : (i + 1) * subgroup]) for i in range(points)]
+
+
+def cycle_labels(name: str, cycles: Sequence[int] | None, n: int) -> tuple[int, ...]:
+    """Checked cycle numbers for ``n`` readings of channel ``name``: 1 .. n when None."""
+    if cycles is None:
+        return tuple(range(1, n + 1))
+    labels = tuple(int(c) for c in cycles)
+    if len(labels) != n or any(c != float(given) for c, given in zip(labels, cycles, strict=True)):
+        raise StationError(
+            f"channel {name!r} has {n} readings but {len(labels)} cycle numbers: give one whole "
+            "cycle number per reading."
+        )
+    return labels
+
+
+def chart_alarms(
+    chart: ControlChart, rule_set: str, unit: str = "", cycles: Sequence[int] | None = None
+) -> tuple[Alarm, ...]:
+    """The run-rule alarms of a chart's location points, labelled by ``cycles`` (the cycle
+    number of each reading; 1, 2, 3 ... when None).
 
     None while the chart has no limits, and none when its sigma is 0 (every reading equal):
     limits on the centre line make every zone rule meaningless.
@@ -148,12 +176,30 @@ def chart_alarms(chart: ControlChart, rule_set: str, unit: str = "") -> tuple[Al
     sigma = chart.point_sigma
     if chart.center is None or sigma is None or not sigma > 0 or not chart.points:
         return ()
-    return tuple(check_rules(chart.points, chart.center, sigma, rule_set, unit=unit or None))
+    if cycles is None:
+        cycles = range(1, len(chart.points) * chart.subgroup + 1)
+    return tuple(
+        check_rules(
+            chart.points,
+            chart.center,
+            sigma,
+            rule_set,
+            unit=unit or None,
+            cycles=point_cycles(cycles, chart.subgroup, len(chart.points)),
+        )
+    )
 
 
-def analyze_channel(name: str, values: np.ndarray, config: AnalysisConfig) -> ChannelAnalysis:
-    """The full analysis of one channel's readings (in cycle order)."""
+def analyze_channel(
+    name: str,
+    values: np.ndarray | Sequence[float],
+    config: AnalysisConfig,
+    cycles: Sequence[int] | None = None,
+) -> ChannelAnalysis:
+    """The full analysis of one channel's readings (in cycle order); ``cycles`` numbers them
+    (1, 2, 3 ... when None)."""
     values = np.asarray(values, dtype=float)
+    labels = cycle_labels(name, cycles, len(values))
     limits = config.limits_for(name)
     descriptive = describe(values, config.resolution)
     hist = histogram(
@@ -181,10 +227,11 @@ def analyze_channel(name: str, values: np.ndarray, config: AnalysisConfig) -> Ch
         histogram=hist,
         capability=cap,
         chart=chart,
-        alarms=chart_alarms(chart, config.rule_set, config.unit),
+        alarms=chart_alarms(chart, config.rule_set, config.unit, labels),
         readings=tuple(values.tolist()),
         limits=limits,
         nominal=config.nominal_for(name),
+        cycles=labels,
     )
 
 
@@ -224,11 +271,15 @@ def analyze(
     config: AnalysisConfig,
     *,
     excluded_cycles: Sequence[int] = (),
+    cycles: Mapping[str, Sequence[int]] | None = None,
 ) -> Analysis:
     """Analyse every channel, the 3-D figures and the hints.
 
-    Raises StationError when there is no channel, when a channel has no readings, or when
-    ``config.limits`` names a channel that is not in ``channels``.
+    ``cycles`` maps a channel to the cycle number of each of its readings (a session's
+    :meth:`~station.session.model.Session.channel_cycles`); a channel without an entry is
+    numbered 1, 2, 3 ... Raises StationError when there is no channel, when a channel has no
+    readings, when its cycle numbers do not match its readings, or when ``config.limits``
+    names a channel that is not in ``channels``.
     """
     if not channels:
         raise StationError("there are no channels to analyse.")
@@ -241,7 +292,11 @@ def analyze(
     for name, values in channels.items():
         if len(values) == 0:
             raise StationError(f"channel {name!r} has no readings.")
-    analysed = {name: analyze_channel(name, values, config) for name, values in channels.items()}
+    labels = cycles or {}
+    analysed = {
+        name: analyze_channel(name, values, config, labels.get(name))
+        for name, values in channels.items()
+    }
     return combine(analysed, config, excluded_cycles=excluded_cycles)
 
 
@@ -283,6 +338,7 @@ def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
         "max": _number(d.max),
         "range": _number(d.range),
         "nominal": _number(channel.nominal),
+        "cycles": list(channel.cycles),
         "capability": {
             "lsl": _number(cap.lsl),
             "usl": _number(cap.usl),
@@ -316,7 +372,8 @@ def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
             "message": chart.message,
         },
         "alarms": [
-            {"rule": a.rule, "points": list(a.points), "text": a.text} for a in channel.alarms
+            {"rule": a.rule, "points": list(a.points), "cycles": list(a.cycles), "text": a.text}
+            for a in channel.alarms
         ],
     }
 

@@ -4,41 +4,45 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from station.commands._args import parse_number
 from station.errors import StationError
+from station.procedures import ANALYSIS_KINDS
 
 if TYPE_CHECKING:
     from station.analysis.summary import AnalysisConfig
 
-SESSION_FORMAT = "station-session/1"
 RULE_CHOICES = ("report", "western-electric", "nelson")
-PROCEDURE_CHOICES = ("repeatability", "linearity", "relative_accuracy")
 LINEARITY_COLUMNS = ("stroke", "s", "h", "v")
 ACCURACY_COLUMNS = ("placement", "x", "y", "z")
 PENDANT_COLUMNS = ("px", "py", "pz")
 
 DESCRIPTION = """\
-Analyse readings the way the 1990 NASA/KSC report does: maximum, average, minimum, sigma,
-skewness, range, mode, histogram, control chart with run rules, Cp/Cpu/Cpl/Cpk and the verdict.
-FILE is a CSV table (a header row, '#' comment lines, one numeric column per channel; columns
-named cycle, subgroup or t are not channels) or a session file (.jsonl).
+Analyse readings the way the 1990 NASA/KSC report does: maximum, average,
+minimum, sigma, skewness, range, mode, histogram, control chart with run rules,
+Cp/Cpu/Cpl/Cpk and the verdict. FILE is a CSV table (a header row, '#' comment
+lines, one numeric column per channel; columns named cycle, subgroup or t are
+not channels) or a session file (.jsonl).
 
---procedure linearity reads a CSV with columns stroke, s, h, v (one row per streamed point) and
-adds the straightness per stroke (least squares and minimum zone of h and v against s), per
-direction, the path repeatability along the bar and the capability of the straightness against
---tolerance. --procedure relative_accuracy reads columns placement, x, y, z (optionally the
-teach pendant's px, py, pz) and adds the accuracy per placement and across placements. A session
-file is analysed by its own procedure unless --procedure says otherwise.
+--procedure linearity reads a CSV with columns stroke, s, h, v (one row per
+streamed point) and adds the straightness per stroke (least squares and minimum
+zone of h and v against s), per direction, the path repeatability along the bar
+and the capability of the straightness against --tolerance. --procedure
+relative_accuracy reads columns placement, x, y, z (optionally the teach
+pendant's px, py, pz) and adds the accuracy per placement and across
+placements. A session file is analysed as its procedure declares (its
+`analysis`) unless --procedure says otherwise.
 
 exit codes:
   0  analysed
-  1  with --fail-if-incapable: a channel is not capable, or has no verdict (no limits)
-  2  bad input: missing or empty file, a cell that is not a number, impossible limits
+  1  with --fail-if-incapable: a channel is not capable, or has no verdict (no
+     limits)
+  2  bad input: missing or empty file, a cell that is not a number, impossible
+     limits
 """
 
 
@@ -85,8 +89,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--unit", default="", help="unit of the readings, for the report")
     parser.add_argument(
         "--procedure",
-        choices=PROCEDURE_CHOICES,
-        help="what FILE holds (default: a session's own procedure, else repeatability)",
+        choices=ANALYSIS_KINDS,
+        metavar="KIND",
+        help=f"what FILE holds: {', '.join(ANALYSIS_KINDS)} (default: the analysis a "
+        "session's procedure declares, else repeatability)",
     )
     parser.add_argument(
         "--tolerance",
@@ -101,19 +107,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="exit 1 when any channel is not capable",
     )
     parser.set_defaults(func=run)
-
-
-def parse_number(text: str | None, option: str) -> float | None:
-    """A finite number given on the command line, None when absent or empty."""
-    if text is None or not text.strip():
-        return None
-    try:
-        value = float(text)
-    except ValueError:
-        raise StationError(f"{option} {text!r} is not a number.") from None
-    if not math.isfinite(value):
-        raise StationError(f"{option} {text!r} is not a finite number.")
-    return value
 
 
 def parse_limit(text: str) -> tuple[str, float | None, float | None]:
@@ -133,16 +126,17 @@ def parse_limit(text: str) -> tuple[str, float | None, float | None]:
 
 
 def is_session_file(path: Path) -> bool:
-    """True when the file's first line is a station session header (or it is named .jsonl)."""
+    """True when the file begins like a station session file (or it is named .jsonl)."""
+    from station.session.model import looks_like_session
+
     if path.suffix.lower() == ".jsonl":
         return True
     try:
         with path.open("rb") as stream:
             first = stream.readline(65536)
-        header = json.loads(first)
-    except (OSError, ValueError):
+    except OSError:
         return False
-    return isinstance(header, dict) and header.get("format") == SESSION_FORMAT
+    return looks_like_session(first)
 
 
 @dataclass
@@ -150,10 +144,11 @@ class Source:
     """What a file gives the analysis: channels, and for a session its recorded settings."""
 
     channels: dict[str, Any]
+    cycles: dict[str, Any] | None = None  # the cycle number of each reading, per channel
     excluded_cycles: tuple[int, ...] = ()
     config: AnalysisConfig | None = None  # a session's recorded limits, resolution, unit, rules
     notes: tuple[str, ...] = ()
-    procedure: str | None = None  # a session's procedure id
+    analysis: str | None = None  # a session's analysis kind (see session_analysis)
     session: Any = None  # the replayed session (station.session.model.Session)
     table: Any = None  # the CSV table (station.session.tables.ReadingTable)
 
@@ -173,15 +168,48 @@ def load_session_source(path: Path) -> Source:
     if session.torn is not None:
         notes.append(f"Torn tail: {session.torn.message}")
     channels = {name: values for name, values in session.channel_values().items() if len(values)}
+    cycles = session.channel_cycles()
     return Source(
         channels=channels,
+        cycles={name: cycles[name] for name in channels},
         excluded_cycles=tuple(session.excluded_cycles),
         # The same settings the live analysis of the running session used.
         config=analysis_config(session.header),
         notes=tuple(notes),
-        procedure=session.procedure_id,
+        analysis=session_analysis(session),
         session=session,
     )
+
+
+def session_analysis(session: Any) -> str:
+    """How to analyse a session: the analysis its header records for its procedure; else that
+    of the same procedure file (id and sha256) where this machine has it; else what the
+    session holds, as a procedure's default follows its steps (streamed strokes: linearity;
+    captures at fixture placements: relative accuracy; otherwise repeatability)."""
+    from station.procedures import discover_procedures
+
+    recorded = session.header["procedure"]
+    if recorded.get("analysis") in ANALYSIS_KINDS:
+        return str(recorded["analysis"])
+    try:
+        catalog = discover_procedures()
+        procedure = next(
+            (
+                p
+                for p in catalog.procedures
+                if p.id == recorded.get("id") and p.sha256 == recorded.get("sha256")
+            ),
+            None,
+        )
+    except StationError:  # a STATION_PROCEDURES folder that is gone: judge by the content
+        procedure = None
+    if procedure is not None:
+        return procedure.analysis
+    if session.samples:
+        return "linearity"
+    if any(cycle.placement is not None for cycle in session.cycles.values()):
+        return "relative_accuracy"
+    return "repeatability"
 
 
 def load_source(path: Path) -> Source:
@@ -191,7 +219,8 @@ def load_source(path: Path) -> Source:
     from station.session.tables import read_table
 
     table = read_table(path)
-    return Source(channels=table.channels, table=table)
+    cycles = None if table.cycles is None else dict.fromkeys(table.channels, table.cycles)
+    return Source(channels=table.channels, cycles=cycles, table=table)
 
 
 def linearity_profiles(source: Source, path: Path) -> list[Any]:
@@ -311,7 +340,7 @@ def run(args: argparse.Namespace) -> int:
         rule_set=args.rules or recorded.rule_set,
         threshold=recorded.threshold if threshold is None else threshold,
     )
-    procedure = args.procedure or source.procedure or "repeatability"
+    procedure = args.procedure or source.analysis or "repeatability"
     tolerance = parse_number(args.tolerance, "--tolerance")
     if tolerance is not None and not tolerance > 0:
         raise StationError(f"--tolerance {args.tolerance!r} must be greater than 0.")
@@ -352,7 +381,9 @@ def run(args: argparse.Namespace) -> int:
     else:
         if not channels:
             raise StationError(f"{path}: the session has no accepted readings to analyse yet.")
-        analysis = analyze(channels, config, excluded_cycles=source.excluded_cycles)
+        analysis = analyze(
+            channels, config, excluded_cycles=source.excluded_cycles, cycles=source.cycles
+        )
         document = to_json(analysis)
         sections = []
     document["procedure"] = procedure

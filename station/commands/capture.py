@@ -21,8 +21,27 @@ scale's direction of travel (:meth:`~station.runner.Runner.stream_strokes`), and
 stroke's points are on disk. The command stops after N whole strokes and ends with the
 procedure's report (the same as ``station analyze FILE``).
 
+Units: the session's unit and gauge resolution are the procedure's unless ``--unit`` and
+``--resolution`` say otherwise (with another unit than the procedure's, its resolution and
+limits do not apply: give ``--resolution`` and ``--limit`` in that unit). When a port's frames
+say their unit (U-WAVE, CDI, Digimatic, ASCII), one reading set is taken before the session
+file is created (and before a resume is written), and gauges in another unit are refused with
+one line; with ``--trigger push`` that set is the devices' next one (press DATA once, or the
+check waits ``--timeout`` and leaves it to the zero step, which checks too). Frames without a
+unit (Mitutoyo) say nothing: only ``--unit`` can.
+
+``--resume FILE`` continues the session as it was set up: the line (``--port``, ``--protocol``,
+``--map``) and how this run waits (``--timeout``, ``--attempts``, inputs) may be given; a
+set-up option (``--cycles``, ``--limit``, ``--trigger``, ...) with another value than the
+session's is refused, not ignored (the same value again is accepted).
+
+With ``--trigger push`` the command waits for the operator: a wait with no reading from the
+gauges is not a refused set (``--attempts`` counts only sets that arrived and were refused).
+With any trigger, a set missed while a port reconnects is not one either: the command waits.
+
 Exit codes: 0 finished; 2 a one-line error (bad option, no port, a failed write such as a full
-disk, no complete reading set after ``--attempts`` tries); 128 + the signal number after
+disk, no complete reading set after ``--attempts`` tries); 70 the command itself failed (a bug:
+the session is interrupted and resumable, the line says where); 128 + the signal number after
 SIGHUP (129), SIGINT (130) or SIGTERM (143): an ``interrupted`` event is written and the session
 is resumable with ``--resume FILE``.
 """
@@ -30,6 +49,7 @@ is resumable with ``--resume FILE``.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import getpass
 import signal
 import sys
@@ -41,6 +61,23 @@ from station.errors import StationError
 
 BY = "station capture"
 _SIGNALS = ("SIGHUP", "SIGINT", "SIGTERM")
+CRASH_EXIT = 70
+"""The exit code when the command itself fails (EX_SOFTWARE): a bug, not the user's input."""
+
+_SETUP_OPTIONS = (
+    ("--procedure", "procedure"),
+    ("--robot", "robot"),
+    ("--operator", "operator"),
+    ("--cycles", "cycles"),
+    ("--limit", "limit"),
+    ("--trigger", "trigger"),
+    ("--unit", "unit"),
+    ("--resolution", "resolution"),
+    ("--placements", "placements"),
+    ("--strokes", "strokes"),
+)
+"""The options that set a new session up; a resumed session keeps what its header records (the
+same value again is accepted: a script may repeat its command line with ``--resume``)."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -61,6 +98,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--robot", metavar="NAME", help="the robot under test")
     parser.add_argument("--operator", metavar="NAME", help="operator (default: the login name)")
     parser.add_argument("--cycles", metavar="N", help="cycles to capture (default: procedure's)")
+    from station.procedures import UNITS
+
+    parser.add_argument(
+        "--unit",
+        choices=UNITS,
+        help="the session's unit (default: the procedure's; another one needs --resolution "
+        "and --limit in it)",
+    )
+    parser.add_argument(
+        "--resolution", metavar="R", help="the gauges' resolution (default: the procedure's)"
+    )
     parser.add_argument(
         "--limit",
         metavar="CH=LSL:USL",
@@ -71,7 +119,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--trigger",
         choices=("poll", "push", "stable"),
-        default="poll",
         help="poll: ask the gauges; push: they send (DATA button, foot switch); stable: take "
         "the set once it settles (default poll)",
     )
@@ -118,8 +165,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--resume",
         metavar="FILE",
-        help="continue an unfinished session (its recorded set-up; --port/--protocol/--map "
-        "replace the recorded line)",
+        help="continue an unfinished session as it was set up (--port/--protocol/--map "
+        "replace the recorded line; set-up options are refused)",
     )
     parser.add_argument(
         "--timeout", default="5", metavar="S", help="seconds to wait for a reading set (5)"
@@ -128,19 +175,16 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--attempts",
         default="3",
         metavar="N",
-        help="refused reading sets in a row before giving up (3)",
+        help="refused reading sets in a row before giving up (3; with push, waiting for "
+        "DATA is not a refusal)",
     )
     parser.set_defaults(func=run)
 
 
-def _positive(text: str, option: str, kind: type = float) -> Any:
-    try:
-        value = kind(text)
-    except ValueError:
-        raise StationError(f"{option} {text!r} is not a number") from None
-    if not value > 0:
-        raise StationError(f"{option} must be more than 0, not {text}")
-    return value
+def _positive(text: str | None, option: str, kind: type = float) -> Any:
+    from station.commands.read import positive_number
+
+    return positive_number(text, option, kind)
 
 
 Inputs = dict[int | None, dict[str, str]]
@@ -227,12 +271,25 @@ def _setup(args: argparse.Namespace) -> Any:
     for text in args.limit:
         channel, lsl, usl = parse_limit(text)
         limits[channel] = SpecLimits(lsl=lsl, usl=usl)
+    resolution = _positive(args.resolution, "--resolution")
+    if args.unit and args.unit != procedure.unit:
+        # The procedure's resolution and limits are numbers in its own unit.
+        unlimited = [channel for channel in procedure.limits if channel not in limits]
+        if resolution is None or unlimited:
+            needed = ["--resolution R"] if resolution is None else []
+            needed += [f"--limit {channel}=LSL:USL" for channel in unlimited]
+            raise StationError(
+                f"--unit {args.unit}: procedure {procedure.id}'s resolution and limits are in "
+                f"{procedure.unit}; give them in {args.unit}: {' '.join(needed)}"
+            )
     return SessionSetup(
         procedure=procedure,
         robot=args.robot,
         operator=args.operator if args.operator is not None else getpass.getuser(),
         ports=(PortSetup(args.port, args.protocol, _channel_map(args, procedure.channels)),),
-        trigger=args.trigger,
+        trigger=args.trigger or "poll",
+        unit=args.unit,
+        resolution=resolution,
         limits=limits or None,
         cycles=_positive(args.cycles, "--cycles", int) if args.cycles else None,
         placements=_positive(args.placements, "--placements", int) if args.placements else None,
@@ -250,6 +307,12 @@ def _resume_setup(args: argparse.Namespace) -> Any:
     from station.runner import PortSetup, resume_setup
 
     setup = resume_setup(args.resume, procedures_dirs=args.procedures)
+    conflicts = _resume_conflicts(args, setup)
+    if conflicts:
+        raise StationError(
+            f"{', '.join(conflicts)} cannot change a resumed session: it continues as its "
+            "header records; leave them out, or start a new session"
+        )
     if not args.port:
         return setup
     recorded = setup.ports[0] if setup.ports else None
@@ -258,6 +321,49 @@ def _resume_setup(args: argparse.Namespace) -> Any:
         raise StationError("--protocol missing: the session records no port to take it from")
     port = PortSetup(args.port, protocol, _channel_map(args, setup.channels))
     return resume_setup(args.resume, procedures_dirs=args.procedures, ports=(port,))
+
+
+def _resume_conflicts(args: argparse.Namespace, setup: Any) -> list[str]:
+    """The set-up options given with ``--resume`` whose value differs from the session's, each
+    as ``--cycles 40 (the session's: 30)``."""
+    from station.commands.analyze import parse_limit
+
+    recorded = {
+        "procedure": setup.procedure.id,
+        "robot": setup.robot,
+        "operator": setup.operator,
+        "cycles": setup.resolved_cycles,
+        "trigger": setup.trigger,
+        "unit": setup.resolved_unit,
+        "resolution": setup.resolved_resolution,
+        "placements": setup.placements,
+        "strokes": setup.strokes,
+    }
+    conflicts = []
+    for option, name in _SETUP_OPTIONS:
+        given = getattr(args, name)
+        if given in (None, []):
+            continue
+        if name == "limit":
+            limits = setup.resolved_limits()
+            for text in given:
+                channel, lsl, usl = parse_limit(text)
+                now = limits.get(channel)
+                if now is None or (now.lsl, now.usl) != (lsl, usl):
+                    was = f"{now.lsl}:{now.usl}" if now is not None else "none"
+                    conflicts.append(f"--limit {text} (the session's: {channel}={was})")
+            continue
+        value = recorded[name]
+        if name in ("cycles", "placements", "strokes"):
+            same = value == _positive(given, option, int)
+        elif name == "resolution":
+            same = value == _positive(given, option)
+        else:
+            same = given == value
+        if not same:
+            was = "the procedure's" if value is None else value
+            conflicts.append(f"{option} {given} (the session's: {was})")
+    return conflicts
 
 
 def _check_answerable(runner_plan: Any, procedure: Any, inputs: Inputs, done: set) -> None:
@@ -288,7 +394,10 @@ def _check_answerable(runner_plan: Any, procedure: Any, inputs: Inputs, done: se
 
 class _Headless:
     """Walks the runner through the procedure on a worker thread; the main thread keeps the
-    signals, so an interrupt never lands in the middle of a journal write."""
+    signals, so an interrupt never lands in the middle of a journal write.
+
+    How the walk ended is left for the main thread: ``error`` (a StationError: one line) or
+    ``crash`` (anything else: a bug, which must not end as a finished session)."""
 
     def __init__(
         self,
@@ -307,15 +416,36 @@ class _Headless:
         self.deadband = deadband
         self.still = still
         self.error: StationError | None = None
+        self.crash: BaseException | None = None
         self.done = threading.Event()
+        self.push = runner.setup.trigger == "push"
+        self._waiting = False
 
     def run(self) -> None:
         try:
             self._walk()
         except StationError as error:
             self.error = error
+        except BaseException as error:  # a bug: reported by the main thread, never swallowed
+            self.crash = error
         finally:
             self.done.set()
+
+    def _readings_seen(self) -> int:
+        """Readings the gauges have sent so far (all ports): unchanged over a wait means nobody
+        pressed DATA, which with the push trigger is waiting, not a refused set."""
+        return sum(reader.reading_count for reader in getattr(self.runner.gauges, "readers", ()))
+
+    def _idle(self, step: Any) -> None:
+        """Nobody pressed DATA during a wait: say once, until the next reading, that the
+        command waits for them (push: the operator sets the pace)."""
+        if not self._waiting:
+            print(
+                f"station: waiting for the gauges: press DATA (step {step.title!r})",
+                file=sys.stderr,
+                flush=True,
+            )
+        self._waiting = True
 
     def _walk(self) -> None:
         runner = self.runner
@@ -328,7 +458,15 @@ class _Headless:
             if step.kind == "check":
                 runner.confirm(by=BY)
             elif step.kind == "zero":
-                runner.zero(by=BY)
+                seen = self._readings_seen()
+                try:
+                    runner.zero(by=BY, timeout=self.timeout)
+                except StationError:
+                    if self.push and self._readings_seen() == seen:
+                        self._idle(step)  # nobody pressed DATA yet: the zero waits for them
+                        continue
+                    raise
+                self._waiting = False
             elif step.kind == "input":
                 given = _values_for(self.inputs, state.current.placement)
                 # _check_answerable made sure every required field has a value; the runner
@@ -348,10 +486,20 @@ class _Headless:
             elif step.kind == "cycles" and state.cycle >= state.cycles_target:
                 runner.confirm(by=BY)
             elif step.kind in ("cycles", "capture"):
+                seen = self._readings_seen()
                 outcome = runner.capture(self.timeout, by=BY)
                 if runner.state().status != "running":
                     return
-                refused = 0 if outcome.recorded else refused + 1
+                if outcome.recorded:
+                    refused = 0
+                elif self.push and self._readings_seen() == seen:
+                    self._idle(step)  # no reading at all: the operator has not pressed DATA yet
+                    continue
+                elif outcome.port_down:
+                    continue  # the line is reconnecting: not the gauges' refusal; wait for it
+                else:
+                    refused += 1
+                self._waiting = False
                 if refused >= self.attempts:
                     raise StationError(
                         f"{refused} reading sets in a row were refused (last: "
@@ -379,21 +527,82 @@ def _print_stroke(outcome: Any) -> None:
     print(f"{outcome.line()} {figures} (LS straightness)", flush=True)
 
 
-def _printer(notice: Any) -> None:
-    """Print acknowledged cycles and the runner's warnings as they happen (listener)."""
-    event = notice.event
-    if event is not None and event.get("type") == "reading":
-        values = {ch: spec["value"] for ch, spec in event["channels"].items()}
-        line = f"cycle {event['cycle']} " + " ".join(f"{ch}={v:+.5f}" for ch, v in values.items())
+class _Printer:
+    """The runner's listener: prints acknowledged cycles, steps and zeroes as they happen, and
+    its warnings on stderr (a warning repeated with nothing in between is printed once: a
+    push device left idle, or the same refusal, would otherwise fill the terminal)."""
+
+    def __init__(self, resolution: float) -> None:
+        self.resolution = resolution
+        self._last_warning: str | None = None
+
+    def __call__(self, notice: Any) -> None:
+        from station.runner import CycleRecord
+
+        event = notice.event
+        kind = event.get("type") if event is not None else None
+        if kind == "reading":
+            # The runner's own cycle line: values at the gauges' decimals, as they show them.
+            values = {ch: spec["value"] for ch, spec in event["channels"].items()}
+            record = CycleRecord(
+                event["cycle"], values, event["step"], None, resolution=self.resolution
+            )
+            self._print(record.line())
+        elif kind == "step":
+            self._print(f"step {event['step']}: done (by {event.get('by', 'operator')})")
+        elif kind == "zero":
+            zeroed = ", ".join(f"{ch} ({spec['method']})" for ch, spec in event["channels"].items())
+            self._print(f"zeroed {zeroed}")
+        elif notice.message is not None and notice.message.level == "warning":
+            # Errors are not printed here: each one also ends the command with its own line.
+            text = notice.message.text
+            if text != self._last_warning:
+                print(f"station: warning: {text}", file=sys.stderr, flush=True)
+            self._last_warning = text
+
+    def _print(self, line: str) -> None:
         print(line, flush=True)
-    elif event is not None and event.get("type") == "step":
-        print(f"step {event['step']}: done (by {event.get('by', 'operator')})", flush=True)
-    elif event is not None and event.get("type") == "zero":
-        zeroed = ", ".join(f"{ch} ({spec['method']})" for ch, spec in event["channels"].items())
-        print(f"zeroed {zeroed}", flush=True)
-    elif notice.message is not None and notice.message.level == "warning":
-        # Errors are not printed here: each one also ends the command with its own line.
-        print(f"station: warning: {notice.message.text}", file=sys.stderr)
+        self._last_warning = None
+
+
+def _check_units(gauges: Any, setup: Any, timeout: float, resume: str | None) -> None:
+    """Take one reading set and refuse, before anything is written, gauges whose frames say
+    they read in another unit than the session's (a frame without a unit says nothing)."""
+    from station.instruments.gauge import unit_mismatch
+
+    if not any(_frames_carry_unit(reader.protocol) for reader in gauges.readers):
+        return  # e.g. Mitutoyo: the frames say nothing, so only --unit can (no set is taken)
+    if setup.trigger == "push":
+        print(
+            f"unit check: press DATA once on the gauges (waiting up to {timeout:g} s)", flush=True
+        )
+    result = gauges.capture(timeout)
+    unit = setup.resolved_unit
+    mismatch = unit_mismatch(result.readings, setup.channels, unit)
+    if not mismatch:
+        return
+    if resume:
+        advice = f"switch the gauges to {unit}, then resume again"
+    else:
+        other = next(r.unit for ch, r in result.readings.items() if r.unit != unit)
+        advice = (
+            f"start it in their unit (--unit {other} with --resolution and --limit in {other}), "
+            f"or switch the gauges to {unit}"
+        )
+    raise StationError(f"{mismatch}: {advice}; nothing was written")
+
+
+def _frames_carry_unit(protocol: Any) -> bool:
+    """True when the protocol's frames say their unit: a frame it encodes in each unit parses
+    back with that unit (a unit-less frame parses with none)."""
+    from station.procedures import UNITS
+
+    channel = protocol.channels[0]
+    for unit in UNITS:
+        parsed = protocol.parse(protocol.encode(channel, 0.0, 0.001, unit).rstrip(b"\r\n"))
+        if getattr(parsed, "unit", None) != unit:
+            return False
+    return True
 
 
 def run(args: argparse.Namespace) -> int:
@@ -436,14 +645,16 @@ def run(args: argparse.Namespace) -> int:
                 if r.state != "connected"
             )
             raise StationError(f"the gauges did not connect within {timeout:g} s ({problems})")
+        _check_units(gauges, setup, timeout, args.resume)
         if caught:
             return 128 + caught[0]  # before any session exists: nothing to record
+        printer = _Printer(setup.resolved_resolution)
         if args.resume:
-            runner = Runner.resume(args.resume, gauges, setup=setup, listener=_printer, by=BY)
+            runner = Runner.resume(args.resume, gauges, setup=setup, listener=printer, by=BY)
         else:
             folder, why = sessions_folder(args.sessions)
             print(f"sessions folder: {folder} ({why})", flush=True)
-            runner = Runner.start(setup, gauges, folder, listener=_printer)
+            runner = Runner.start(setup, gauges, folder, listener=printer)
         print(f"session file: {runner.path}", flush=True)
         headless = _Headless(runner, inputs, timeout, attempts, deadband=deadband, still=still)
         worker = threading.Thread(target=headless.run, name="station capture", daemon=True)
@@ -463,13 +674,9 @@ def run(args: argparse.Namespace) -> int:
                 file=sys.stderr,
             )
             return 128 + signum
-        if headless.error is not None:
-            # Say in the file why the session stopped (unless the disk itself failed).
-            message = headless.error.message
-            runner.interrupt(f"station capture stopped: {message}")
-            if "--resume" not in message:
-                message += f" (resume with `station capture --resume {runner.path}`)"
-            raise StationError(message)
+        return_code = _ended(runner, headless)
+        if return_code is not None:
+            return return_code
         analysis = runner.finish(by=BY)
     finally:
         if gauges is not None:
@@ -478,6 +685,43 @@ def run(args: argparse.Namespace) -> int:
             signal.signal(signum, handler)
     _print_summary(runner, analysis)
     return 0
+
+
+def _ended(runner: Any, headless: _Headless) -> int | None:
+    """How the walk ended when it did not complete every step: the exit code after one line
+    on stderr (or a StationError), ``None`` when the session is complete and may be finished."""
+    resume = f"`station capture --resume {runner.path}`"
+    if headless.crash is not None:
+        crash = headless.crash
+        what = f"{type(crash).__name__}: {crash}".rstrip(": ")
+        # The file says why it stopped, and stays resumable: a bug is not the end of a session.
+        with contextlib.suppress(StationError):  # a failed write says so in its own status
+            runner.interrupt(f"station capture crashed: {what}")
+        print(
+            f"station: station capture crashed ({what}); the session is interrupted, "
+            f"nothing acknowledged is lost: resume it with {resume} (and report the bug)",
+            file=sys.stderr,
+        )
+        return CRASH_EXIT
+    state = runner.state()
+    if state.status == "failed":
+        # The write failure's own sentence (a full disk, a file-size limit), not a bare "failed".
+        message = runner.failure or f"a write to the session file failed: {runner.path}"
+        if "--resume" not in message:
+            message += f" (resume with {resume})"
+        raise StationError(message)
+    if headless.error is not None:
+        # Say in the file why the session stopped (unless the disk itself failed).
+        message = headless.error.message
+        runner.interrupt(f"station capture stopped: {message}")
+        if "--resume" not in message:
+            message += f" (resume with {resume})"
+        raise StationError(message)
+    if not state.complete:
+        raise StationError(
+            f"the session is {state.status} before every step was done; resume it with {resume}"
+        )
+    return None
 
 
 _PROCEDURE_REPORTS = ("linearity", "relative_accuracy")

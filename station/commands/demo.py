@@ -1,9 +1,13 @@
-"""``station demo``: the whole repeatability procedure against simulated indicators.
+"""``station demo``: a whole procedure against simulated instruments, no hardware.
 
-It starts the simulator in this process on a pseudo-terminal, pre-fills the set-up with its
-port, and writes the demo's session files to a ``demo`` folder under the sessions folder (said on
-screen). ``--autopilot`` walks the procedure by itself (confirming the steps, capturing every
-cycle at a watchable pace, rejecting one cycle with a reason) and stops on the summary.
+It starts the procedure's simulator in this process on a pseudo-terminal (three indicators in a
+fixture for repeatability; two fixtures and a teach pendant for relative accuracy; a parallel
+bar with indicators h, v and a linear scale s for linearity), pre-fills the set-up with its port,
+and writes the demo's session files to a ``demo`` folder under the sessions folder (said on
+screen). Picking another procedure in the set-up starts that procedure's simulator. All are
+seeded and deterministic. ``--autopilot`` walks the procedure by itself (confirming the steps,
+typing the pendant's coordinates, capturing every cycle or streaming every stroke at a watchable
+pace, rejecting one cycle with a reason) and stops on the summary.
 """
 
 from __future__ import annotations
@@ -18,9 +22,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
     parser = subparsers.add_parser(
         "demo",
-        help="try the whole procedure against simulated dial indicators (no hardware)",
-        description="Runs the TUI against a simulated robot in a fixture with three dial "
-        "indicators on a pseudo-terminal: set-up, checklist, 30 cycles, verdict.",
+        help="try a whole procedure against simulated instruments (no hardware)",
+        description="Runs the TUI against a simulated robot on a pseudo-terminal: set-up, "
+        "checklist, captures, verdict. repeatability: a fixture with three dial indicators, "
+        "30 cycles; relative_accuracy: two fixtures and a teach pendant, a few placements; "
+        "linearity: a parallel bar with indicators h, v and a linear scale s, 30 strokes.",
     )
     parser.add_argument(
         "--autopilot",
@@ -31,7 +37,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--procedure",
         default="repeatability",
         metavar="ID",
-        help="procedure id (default: %(default)s)",
+        help="procedure id: repeatability, relative_accuracy or linearity (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--count",
+        type=int,
+        metavar="N",
+        help="cycles (repeatability), fixture placements (relative_accuracy) or strokes "
+        "(linearity) to pre-fill in the set-up (default: the procedure's)",
     )
     parser.add_argument(
         "--seed", type=int, default=1990, help="simulator seed (default: %(default)s)"
@@ -53,13 +66,16 @@ def run(args: argparse.Namespace) -> int:
     from station.errors import StationError
     from station.session.store import sessions_folder
     from station.tui.app import DemoPort, StationApp, StationConfig
-    from station.tui.instruments import start_demo_fixture
+    from station.tui.instruments import DemoLab
 
     if args.pace < 0:
         raise StationError(f"--pace must be 0 or more seconds, not {args.pace}")
+    if args.count is not None and args.count < 1:
+        raise StationError(f"--count must be 1 or more, not {args.count}")
     folder, reason = sessions_folder(args.sessions)
-    fixture = start_demo_fixture(args.seed)
+    lab = DemoLab(args.seed)
     try:
+        fixture = lab.fixture(args.procedure)
         config = StationConfig(
             sessions_dir=folder / "demo",
             sessions_reason=f"the demo folder under {folder} ({reason})",
@@ -69,10 +85,14 @@ def run(args: argparse.Namespace) -> int:
                 protocol=fixture.protocol,
                 channel_map=fixture.channel_map,
                 procedure=args.procedure,
+                description=fixture.description,
+                trigger=fixture.trigger,
+                count=args.count,
             ),
+            demo_lab=lab,
             autopilot=args.autopilot,
             autopilot_pace=args.pace,
         )
         return run_app(StationApp(config), mouse=args.mouse)
     finally:
-        fixture.stop()
+        lab.stop()

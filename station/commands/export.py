@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 
@@ -34,6 +33,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Export; StationError for a missing session or an existing OUT without --force."""
+    from station.session.durable import replace_durably
     from station.session.export import export_csv
     from station.session.model import load_session
 
@@ -46,13 +46,10 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.output)
     if out.exists() and not args.force:
         raise StationError(f"{out} exists; pass --force to overwrite it or choose another name")
-    partial = out.with_name(f".{out.name}.partial")
     try:
-        with open(partial, "w", encoding="utf-8", newline="") as handle:
-            rows = export_csv(session, handle)
-        os.replace(partial, out)
+        # Synced before the rename and the folder after: OUT is whole or absent after a crash.
+        rows = replace_durably(out, lambda handle: export_csv(session, handle))
     except OSError as error:
-        partial.unlink(missing_ok=True)
         raise StationError(f"cannot write {out}: {error.strerror}") from None
     print(f"wrote {rows} rows to {out}", file=sys.stderr)
     return 0

@@ -9,20 +9,24 @@ import sys
 import threading
 import time
 
+from station.commands._args import positive_number
 from station.errors import StationError
 
 DESCRIPTION = """\
-Open a gauge port and print each reading as it arrives (station channel, value, unit and the
-raw frame) and one line per rejected frame (error, status, malformed, out of range). A polled
-protocol is polled continuously (--interval); a push protocol waits for the device (DATA
-button, foot switch, data logger); --trigger stable prints a set once every channel has stayed
-within 2 x resolution for 0.5 s. Connection changes go to stderr; the reader reconnects by
-itself after an unplug. Ctrl-C stops.
+Open a gauge port and print each reading as it arrives (station channel, value,
+unit and the raw frame) and one line per rejected frame (error, status,
+malformed, out of range). A polled protocol is polled continuously
+(--interval); a push protocol waits for the device (DATA button, foot switch,
+data logger); --trigger stable prints a set once every channel has stayed
+within 2 x resolution for 0.5 s. Connection changes go to stderr; the reader
+reconnects by itself after an unplug. Ctrl-C stops.
 
---jsonl prints one JSON object per line instead: {"channel", "value", "unit", "raw"} for a
-reading, {"rejected", "raw"} for a rejected frame (rejected = the reason).
+--jsonl prints one JSON object per line instead: {"channel", "value", "unit",
+"raw"} for a reading, {"rejected", "raw"} for a rejected frame (rejected = the
+reason).
 
-exit codes: 0 done (or --count reached); 2 bad port, protocol or option; 130 interrupted.
+exit codes: 0 done (or --count reached); 2 bad port, protocol or option; 130
+interrupted.
 """
 
 
@@ -81,7 +85,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--resolution",
         default="0.001",
         metavar="R",
-        help="gauge resolution, for --trigger stable (default 0.001)",
+        help="gauge resolution: the decimals shown, and the band of --trigger stable "
+        "(default 0.001)",
     )
     parser.set_defaults(func=run)
 
@@ -105,20 +110,18 @@ def parse_map(text: str | None) -> dict[str, str]:
     return mapping
 
 
-def positive_number(text: str | None, name: str, kind: type = float) -> float | int | None:
-    """``text`` as a positive number (None stays None); StationError otherwise."""
-    if text is None:
-        return None
-    try:
-        value = kind(text)
-    except ValueError:
-        raise StationError(f"{name} {text!r} is not a number.") from None
-    if not value > 0:
-        raise StationError(f"{name} must be more than 0, not {text}.")
-    return value
+def value_text(value: float, resolution: float) -> str:
+    """A reading with its sign at the decimals a gauge of ``resolution`` shows (``+0.000``
+    beside ``-0.001``); a value with finer digits than that keeps them (up to 6)."""
+    from station.instruments.protocols.common import decimals_for
+
+    decimals = decimals_for(resolution)
+    while decimals < 6 and round(value, decimals) != value:
+        decimals += 1
+    return f"{value:+.{decimals}f}"
 
 
-def _print_item(item: object, jsonl: bool) -> bool:
+def _print_item(item: object, jsonl: bool, resolution: float) -> bool:
     """Print a reading or a rejection; True when it was a reading."""
     from station.instruments.base import Reading
 
@@ -128,7 +131,9 @@ def _print_item(item: object, jsonl: bool) -> bool:
                 {"channel": item.channel, "value": item.value, "unit": item.unit, "raw": item.raw}
             )
         else:
-            line = f"{item.channel:>4}  {item.value:+.6g} {item.unit}  {item.raw}"
+            line = (
+                f"{item.channel:>4}  {value_text(item.value, resolution)} {item.unit}  {item.raw}"
+            )
         print(line, flush=True)
         return True
     if jsonl:
@@ -200,7 +205,7 @@ def run(args: argparse.Namespace) -> int:
                 file=sys.stderr,
                 flush=True,
             )
-        return _loop(reader, gauges, events, trigger, count, interval, args.jsonl)
+        return _loop(reader, gauges, events, trigger, count, interval, args.jsonl, resolution)
     except KeyboardInterrupt:
         return 130
     finally:
@@ -220,7 +225,7 @@ def _wait_first_open(reader) -> None:
         raise StationError(message)
 
 
-def _loop(reader, gauges, events, trigger, count, interval, jsonl) -> int:
+def _loop(reader, gauges, events, trigger, count, interval, jsonl, resolution) -> int:
     readings = 0
     # A poll waits for its answers (or POLL_PATIENCE) before the next one: a new poll flushes
     # the input, so polling faster than the device answers would starve the reader.
@@ -231,10 +236,10 @@ def _loop(reader, gauges, events, trigger, count, interval, jsonl) -> int:
         if gauges is not None:
             result = gauges.capture(timeout=max(2.0, 4 * interval))
             while not events.empty():
-                _print_item(events.get_nowait(), jsonl)
+                _print_item(events.get_nowait(), jsonl, resolution)
             for channel in result.channels:
                 if channel in result.readings and (count is None or readings < count):
-                    readings += _print_item(result.readings[channel], jsonl)
+                    readings += _print_item(result.readings[channel], jsonl, resolution)
             continue
         now = time.monotonic()
         if (
@@ -248,7 +253,7 @@ def _loop(reader, gauges, events, trigger, count, interval, jsonl) -> int:
             item = events.get(timeout=0.02)
         except queue.Empty:
             continue
-        is_reading = _print_item(item, jsonl)
+        is_reading = _print_item(item, jsonl, resolution)
         readings += is_reading
         answered += 1  # a rejected frame is an answer too
     return 0

@@ -7,36 +7,42 @@ import signal
 import sys
 import threading
 
-from station.commands.read import positive_number
+from station.commands._args import positive_number
 from station.errors import StationError
 
 DESCRIPTION = """\
-Run a simulated fixture with one dial indicator per channel, speaking a gauge protocol, so that
-`station read`, `station capture` and the TUI work with no hardware. The first line on stdout
-is the URL to open (a pseudo-terminal path, or socket://127.0.0.1:PORT with --tcp); it then
-runs until Ctrl-C or SIGTERM. Seeded: the k-th reading of a channel depends only on --seed and
-k. With --disconnect-every on a pty the URL is a symlink that follows the pty across
+Run a simulated fixture with one dial indicator per channel, speaking a gauge
+protocol, so that `station read`, `station capture` and the TUI work with no
+hardware. The first line on stdout is the URL to open (a pseudo-terminal path,
+or socket://127.0.0.1:PORT with --tcp); it then runs until Ctrl-C or SIGTERM.
+Seeded: the k-th reading of a channel depends only on --seed and k. With
+--disconnect-every on a pty the URL is a symlink that follows the pty across
 disconnects.
 
-Model options take one value for every channel or CH=V pairs, e.g. --bias x=0.002,y=-0.001.
-Fault rates are probabilities per frame sent.
+Model options take one value for every channel or CH=V pairs, e.g. --bias
+x=0.002,y=-0.001. Fault rates are probabilities per frame sent.
 
---model chooses the set-up (channels and unit follow from it for the two others):
+--model chooses the set-up (channels and unit follow from it for the two
+others):
   fixture      one fixture, indicators x, y, z (repeatability; the default).
-  two-fixture  relative accuracy (report 2.8): x, y, z in inches. Each placement's second
-               fixture is where the teach pendant says (printed on stderr as "placement P:
-               the pendant reads X=... Y=... Z=... in" when the robot gets there); the
-               indicators at the first fixture read the return's error: --scale per unit moved,
-               --rotation (radians) about x, y, z, --noise. A protocol without a zero command is
-               zeroed in software, which reads one set at home per placement; the simulated
-               robot follows that order (one home reading, then the return).
-  bar          linearity (report 2.9): indicators h, v and the linear scale s in inches. The
-               robot shuttles A-B-A... along the bar (--length, --points per stroke, --dwell
-               readings at each end); h sees the bar's bow (--bow sagitta), v its sag (--sag),
-               both the path's wobble (--wobble, --wobble-v, --period). The indicators and the
-               scale's counter send every set by themselves at --push-rate sets per second
-               (default 200, as a counter's continuous output does): capture with
-               --trigger push. The robot advances one point per set sent.
+  two-fixture  relative accuracy (report 2.8): x, y, z in inches. Each
+               placement's second fixture is where the teach pendant says
+               (printed on stderr as "placement P: the pendant reads X=...
+               Y=... Z=... in" when the robot gets there); the indicators at
+               the first fixture read the return's error: --scale per unit
+               moved, --rotation (radians) about x, y, z, --noise. A protocol
+               without a zero command is zeroed in software, which reads one
+               set at home per placement; the simulated robot follows that
+               order (one home reading, then the return).
+  bar          linearity (report 2.9): indicators h, v and the linear scale s
+               in inches. The robot shuttles A-B-A... along the bar (--length,
+               --points per stroke, --dwell readings at each end); h sees the
+               bar's bow (--bow sagitta), v its sag (--sag), both the path's
+               wobble (--wobble, --wobble-v, --period). The indicators and the
+               scale's counter send every set by themselves at --push-rate sets
+               per second (default 200, as a counter's continuous output does):
+               capture with --trigger push. The robot advances one point per
+               set sent.
 """
 
 
@@ -289,7 +295,10 @@ def run(args: argparse.Namespace) -> int:
     if args.model == "two-fixture":
         show_pendant(simulator)
     done = threading.Event()
-    previous = signal.signal(signal.SIGTERM, lambda *_: done.set())
+    # A hang-up (the SSH session closing) or Ctrl-C stops as cleanly as SIGTERM: the pty, the
+    # link and its private folder go away.
+    stop_signals = (signal.SIGTERM, signal.SIGHUP, signal.SIGINT)
+    previous = {sig: signal.signal(sig, lambda *_: done.set()) for sig in stop_signals}
     try:
         if args.tcp is not None:
             try:
@@ -312,12 +321,9 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
             flush=True,
         )
-        try:
-            while not done.wait(0.2):
-                pass
-        except KeyboardInterrupt:
-            pass
+        done.wait()
         return 0
     finally:
         simulator.stop()
-        signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)

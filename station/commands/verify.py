@@ -12,9 +12,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="check that a session file is intact (hash chain, events)",
         description=(
             "Check a session file without changing it: every line's hash, the chain of 'prev' "
-            "hashes, the order of events. Prints one line with the last line's hash (quote it "
-            "in a report to anchor the file). Exit 0 when intact, 1 naming the first bad line, "
-            "2 when the file is missing or unreadable."
+            "hashes, the order of events. Prints the verdict, then the last line's hash (quote "
+            "it in a report to anchor the file). Exit 0 when intact, 1 naming the first bad "
+            "line, 2 when the file is missing, unreadable or not a session file."
         ),
     )
     parser.add_argument("file", metavar="FILE", help="the session file (.jsonl)")
@@ -26,5 +26,5 @@ def run(args: argparse.Namespace) -> int:
     from station.session.verify import verify_session
 
     result = verify_session(args.file)
-    print(result.message)
+    print(result.report)
     return 0 if result.ok else 1

@@ -260,8 +260,13 @@ class GaugeReader:
         self._wake()
 
     def _down_message(self) -> str:
-        detail = f": {self.last_message}" if self.last_message else ""
-        return f"{self.url} is not connected ({self.state}){detail}"
+        # Short on purpose: it is repeated per refused set, and the full reason was already
+        # reported once through on_status when the state changed.
+        if self.state == "stopped":
+            return f"the port {self.url} is closed"
+        if self.state == "connecting":
+            return f"the port {self.url} is not open yet (connecting...)"
+        return f"the port {self.url} is disconnected (reconnecting...)"
 
     def _wake(self) -> None:
         port = self._port
@@ -478,6 +483,15 @@ class CaptureResult:
     errors: tuple[str, ...] = ()
     """Port problems met during the capture (a disconnected port, a failed request)."""
     t_trigger: float = 0.0
+    disconnected: tuple[str, ...] = ()
+    """Missing channels whose port was down for the whole wait (the set is not the gauges'
+    fault: the line is reconnecting)."""
+
+    @property
+    def port_down(self) -> bool:
+        """True when a channel is missing only because its port was down (not a refusal by
+        the gauges: wait for the line and capture again)."""
+        return bool(self.disconnected)
 
     @property
     def complete(self) -> bool:
@@ -489,7 +503,9 @@ class CaptureResult:
         """One sentence for the operator: empty when the set is complete and clean."""
         parts = []
         if self.missing:
-            fresh_less = [c for c in self.missing if c not in self.stale]
+            fresh_less = [
+                c for c in self.missing if c not in self.stale and c not in self.disconnected
+            ]
             if fresh_less:
                 parts.append("no reading from " + ", ".join(fresh_less))
             if self.stale:
@@ -506,6 +522,23 @@ class CaptureResult:
         if not parts:
             return ""
         return "; ".join(parts) + "."
+
+
+def unit_mismatch(readings: Mapping[str, Reading], channels: Iterable[str], unit: str) -> str:
+    """'' when every one of ``channels`` in ``readings`` reads in ``unit``; else the sentence
+    (without a full stop) ``x, y read in mm but the session is in in``."""
+    other = {}
+    for channel in channels:
+        reading = readings.get(channel)
+        if reading is not None and reading.unit != unit:
+            other.setdefault(reading.unit, []).append(channel)
+    if not other:
+        return ""
+    parts = [
+        f"{', '.join(names)} {'reads' if len(names) == 1 else 'read'} in {other_unit}"
+        for other_unit, names in other.items()
+    ]
+    return "; ".join(parts) + f" but the session is in {unit}"
 
 
 @dataclass(frozen=True)
@@ -663,13 +696,29 @@ class GaugeSet:
     # -- captures ------------------------------------------------------------------------
 
     def _trigger_all(self, send_requests: bool, timeout: float) -> tuple[dict[str, float], list]:
-        """Trigger every reader; the send time per station channel, and the errors."""
+        """Trigger every reader; the send time per station channel, and the errors.
+
+        A port that is down (a short dropout, a device server restarting) is waited for until
+        ``timeout``: the trigger goes out once it is back, so a dropout shorter than the
+        timeout costs a delay, not a refused set. A port still down at the deadline is one
+        error, and its channels get no send time.
+        """
+        deadline = time.monotonic() + timeout
         tickets = [(reader, reader.trigger(send_requests)) for reader in self.readers]
         t_sent: dict[str, float] = {}
         errors = []
-        deadline = time.monotonic() + timeout
         for reader, ticket in tickets:
-            ticket.done.wait(max(0.0, deadline - time.monotonic()))
+            while True:
+                ticket.done.wait(max(0.0, deadline - time.monotonic()))
+                if ticket.t_sent is not None and not ticket.error:
+                    break
+                remaining = deadline - time.monotonic()
+                if not ticket.done.is_set() or remaining <= 0 or not reader.alive:
+                    break
+                # Nothing was sent (the port was or went down): wait for it and trigger again.
+                if not reader.wait_connected(remaining):
+                    break
+                ticket = reader.trigger(send_requests)
             if ticket.error or ticket.t_sent is None:
                 errors.append(ticket.error or f"{reader.url} did not take the trigger in time")
                 continue
@@ -777,8 +826,15 @@ class GaugeSet:
     ) -> CaptureResult:
         missing = tuple(c for c in self.channels if c not in taken)
         stale = []
+        disconnected = tuple(
+            c
+            for c in missing
+            if self._reader_of[c].state != "connected" or (t_sent is not None and c not in t_sent)
+        )
         with self._changed:
             for channel in missing:
+                if channel in disconnected:
+                    continue
                 history = self._history[channel]
                 since = (t_sent or {}).get(channel, t_trigger)
                 if history and history[-1].t_mono < since:
@@ -792,6 +848,7 @@ class GaugeSet:
             duplicated=tuple(c for c in self.channels if c in duplicated),
             errors=tuple(errors),
             t_trigger=t_trigger,
+            disconnected=disconnected,
         )
 
     def arm(self, timeout: float = 1.0) -> list[str]:
@@ -808,6 +865,28 @@ class GaugeSet:
             self._sets.clear()
         return errors
 
+    def set_zero_offsets(self, offsets: Mapping[str, float]) -> None:
+        """Put recorded software-zero offsets back (a resumed session on fresh gauges):
+        ``offsets`` by station channel, 0.0 for a channel zeroed by the device itself."""
+        unknown = [c for c in offsets if c not in self._reader_of]
+        if unknown:
+            raise StationError(
+                f"Cannot restore the zero of {', '.join(unknown)}: this station's channels are "
+                f"{', '.join(self.channels)}."
+            )
+        for channel, offset in offsets.items():
+            self._reader_of[channel].set_zero_offset(channel, float(offset))
+
+    def zero_offsets(self) -> dict[str, float]:
+        """The software zero offsets in force, by station channel (0.0 where none is)."""
+        return {c: self._reader_of[c].zero_offsets().get(c, 0.0) for c in self.channels}
+
+    def read_units(self, timeout: float = 2.0) -> dict[str, str]:
+        """Take one reading set (by this set's trigger) and return the unit each channel reads
+        in (channels that sent nothing are absent): check it against the session's unit before
+        a session starts."""
+        return {channel: r.unit for channel, r in self.capture(timeout).readings.items()}
+
     def wait_set(self, timeout: float) -> CaptureResult | None:
         """The next completed push set, or None when none completes within ``timeout``."""
         deadline = time.monotonic() + timeout
@@ -821,11 +900,19 @@ class GaugeSet:
 
     # -- zeroing -------------------------------------------------------------------------
 
-    def zero(self, channels: Iterable[str] | None = None, timeout: float = 2.0) -> list[ZeroResult]:
+    def zero(
+        self,
+        channels: Iterable[str] | None = None,
+        timeout: float = 2.0,
+        *,
+        unit: str | None = None,
+    ) -> list[ZeroResult]:
         """Zero ``channels`` (all by default): the device's command, else a software offset.
 
         A software zero takes a fresh reading set (by this set's trigger) and subtracts each
-        channel's device value from its later readings.
+        channel's device value from its later readings; with ``unit`` it refuses (nothing
+        zeroed) when a channel reads in another unit. A port that is down is waited for until
+        ``timeout``.
         """
         wanted = list(self.channels if channels is None else channels)
         unknown = [c for c in wanted if c not in self._reader_of]
@@ -834,6 +921,7 @@ class GaugeSet:
                 f"Cannot zero {', '.join(unknown)}: this station's channels are "
                 f"{', '.join(self.channels)}."
             )
+        deadline = time.monotonic() + timeout
         results: list[ZeroResult] = []
         software = []
         for channel in wanted:
@@ -843,19 +931,30 @@ class GaugeSet:
             )
             command = reader.protocol.zero_command(device_channel)
             if command:
+                # A short dropout is waited out, as a capture waits for it.
+                if not reader.wait_connected(max(0.0, deadline - time.monotonic())):
+                    raise StationError(
+                        f"Could not zero {channel}: {reader._down_message()}. Check the cable "
+                        "and try again."
+                    )
                 reader.send(command)
                 reader.set_zero_offset(channel, 0.0)
                 results.append(ZeroResult(channel, "device", 0.0))
             else:
                 software.append(channel)
         if software:
-            result = self.capture(timeout)
+            result = self.capture(max(0.0, deadline - time.monotonic()))
             absent = [c for c in software if c not in result.readings]
             if absent:
+                why = result.message.rstrip(".") or "timeout"
                 raise StationError(
-                    f"Could not zero {', '.join(absent)}: no fresh reading arrived "
-                    f"({result.message or 'timeout'}). Check the gauges and try again."
+                    f"Could not zero {', '.join(absent)}: no fresh reading arrived ({why}). "
+                    "Check the gauges and try again."
                 )
+            if unit is not None:
+                mismatch = unit_mismatch(result.readings, software, unit)
+                if mismatch:
+                    raise StationError(f"Could not zero: {mismatch}.")
             for channel in software:
                 offset = result.readings[channel].device_value
                 self._reader_of[channel].set_zero_offset(channel, offset)

@@ -247,6 +247,16 @@ class _Link:
     port: int = 0
 
 
+def _is_pty_link(path: Path) -> bool:
+    """True when ``path`` is a symlink to a pseudo-terminal (live or gone): what a simulator
+    makes, so one may replace or remove it; never a file someone else put there."""
+    try:
+        target = os.readlink(path)
+    except OSError:
+        return False
+    return target.startswith(("/dev/pts/", "/dev/tty"))
+
+
 class Simulator:
     """Serve ``model``'s readings in ``protocol``'s frames, with ``faults``, on a pty or TCP.
 
@@ -359,6 +369,12 @@ class Simulator:
             state.link_path = state.own_dir / "gauge"
         elif link:
             state.link_path = Path(link)
+            taken = state.link_path.exists() or state.link_path.is_symlink()
+            if taken and not _is_pty_link(state.link_path):
+                raise StationError(
+                    f"{state.link_path} exists and is not a simulator's link (a symlink to "
+                    "a pseudo-terminal): remove it or choose another --link path"
+                )
         self._link = state
         self._open_pty()
         state.url = str(state.link_path) if state.link_path else os.ttyname(state.slave)
@@ -388,7 +404,7 @@ class Simulator:
         with self._lock:
             self._close_line(listener=True)
             state = self._link
-            if state and state.link_path is not None:
+            if state and state.link_path is not None and _is_pty_link(state.link_path):
                 with contextlib.suppress(OSError):
                     state.link_path.unlink()
             if state and state.own_dir is not None:
@@ -410,9 +426,10 @@ class Simulator:
         os.set_blocking(master, False)
         state.master, state.slave = master, slave
         if state.link_path is not None:
-            temporary = state.link_path.with_name(state.link_path.name + ".new")
-            with contextlib.suppress(FileNotFoundError):
-                temporary.unlink()
+            # A name nobody else uses (symlink() never replaces), renamed over the link at once.
+            temporary = state.link_path.with_name(
+                f".{state.link_path.name}.{os.getpid()}.{os.urandom(4).hex()}.new"
+            )
             os.symlink(os.ttyname(slave), temporary)
             os.replace(temporary, state.link_path)
         self._connected.set()
@@ -432,7 +449,7 @@ class Simulator:
         if state is None:
             return
         self._connected.clear()
-        if state.link_path is not None:
+        if state.link_path is not None and _is_pty_link(state.link_path):
             # While down the link must not point at a pty number the kernel may hand to
             # someone else: the reader then sees "no such port" until the return.
             with contextlib.suppress(OSError):

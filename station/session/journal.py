@@ -42,6 +42,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from station.errors import StationError
+from station.session.durable import fsync_folder, make_folders
 from station.session.model import (
     FORMAT,
     HEADER_REQUIRED,
@@ -56,7 +57,7 @@ from station.session.model import (
 )
 
 if TYPE_CHECKING:
-    from station.procedures import Procedure
+    pass
 
 _NAME_LIMIT = 40
 _UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
@@ -83,62 +84,6 @@ def utc_now_iso(moment: datetime | None = None) -> str:
     return moment.astimezone(UTC).strftime("%Y-%m-%dT%H:%M:%S.%fZ")
 
 
-def session_header(
-    procedure: Procedure,
-    *,
-    robot: str,
-    operator: str = "",
-    unit: str | None = None,
-    resolution: float | None = None,
-    limits: Mapping[str, tuple[float, float] | tuple[float, float, float]] | None = None,
-    channels: tuple[str, ...] | None = None,
-    instruments: Mapping[str, Any] | None = None,
-    cycles_target: int | None = None,
-    rules: str = "report",
-    threshold: float = 1.0,
-    **extra: Any,
-) -> dict[str, Any]:
-    """The header fields of a session that follows ``procedure``, for :meth:`SessionWriter.create`.
-
-    ``limits`` maps a channel to ``(lsl, usl)`` or ``(lsl, usl, nominal)``; without it the
-    procedure's default limits are used. ``instruments`` holds the port, protocol and serial
-    settings (as plain values). ``extra`` fields are kept in the header as given.
-    """
-    if limits is None:
-        limit_table = {
-            ch: {"lsl": lim.lsl, "usl": lim.usl, "nominal": lim.nominal}
-            for ch, lim in procedure.limits.items()
-        }
-    else:
-        limit_table = {}
-        for ch, spec in limits.items():
-            lsl, usl = float(spec[0]), float(spec[1])
-            nominal = float(spec[2]) if len(spec) > 2 else (lsl + usl) / 2
-            if not usl > lsl:
-                raise StationError(f"impossible limits for {ch}: usl {usl} is not above lsl {lsl}")
-            limit_table[ch] = {"lsl": lsl, "usl": usl, "nominal": nominal}
-    return {
-        "procedure": {
-            "id": procedure.id,
-            "version": procedure.version,
-            "sha256": procedure.sha256,
-            "title": procedure.title,
-            "report_section": procedure.report_section,
-        },
-        "robot": robot,
-        "operator": operator,
-        "unit": unit or procedure.unit,
-        "resolution": procedure.resolution if resolution is None else resolution,
-        "limits": limit_table,
-        "channels": list(channels or procedure.channels),
-        "instruments": dict(instruments or {}),
-        "cycles_target": cycles_target or procedure.cycles_target,
-        "rules": rules,
-        "threshold": threshold,
-        **extra,
-    }
-
-
 def _ignore_sigxfsz() -> None:
     if hasattr(signal, "SIGXFSZ") and threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
@@ -155,20 +100,6 @@ def _lock(fd: int, path: Path) -> None:
                 "close that one first"
             ) from None
         raise StationError(f"cannot lock session file {path}: {error.strerror}") from None
-
-
-def _fsync_folder(folder: Path) -> None:
-    # A new file's directory entry is durable only once its folder is synced.
-    try:
-        fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
-    except OSError:
-        return
-    try:
-        os.fsync(fd)
-    except OSError:
-        pass
-    finally:
-        os.close(fd)
 
 
 class SessionWriter:
@@ -197,7 +128,8 @@ class SessionWriter:
         """Create a new session file in ``folder`` and write its header (fsynced).
 
         ``header_fields`` must hold ``robot``, ``procedure`` (``id``, ``version``, ``sha256``),
-        ``channels`` and ``unit`` (see :func:`session_header`); ``format``, ``session``,
+        ``channels`` and ``unit`` (``station.runner.SessionSetup.header_fields`` builds them);
+        ``format``, ``session``,
         ``created``, ``host`` and ``prev`` are filled in. The file is
         ``<date>T<time>Z_<robot>_<procedure>.jsonl`` (UTC; names sanitised), with ``-2``,
         ``-3`` ... before ``.jsonl`` when that name is taken.
@@ -222,7 +154,7 @@ class SessionWriter:
 
         folder = Path(folder)
         try:
-            folder.mkdir(parents=True, exist_ok=True)
+            make_folders(folder)
         except OSError as error:
             raise StationError(
                 f"cannot create the sessions folder {folder}: {error.strerror}"
@@ -255,7 +187,8 @@ class SessionWriter:
         _lock(fd, path)
         writer = cls(path, fd, replay, 0)
         writer._write_line(line, decode_line(line))
-        _fsync_folder(folder)
+        # A new file's name is durable only once its folder is synced.
+        fsync_folder(folder)
         return writer
 
     @classmethod
@@ -307,7 +240,8 @@ class SessionWriter:
 
     @property
     def last_hash(self) -> str:
-        """The sha256 of the last line on disk: print it on summaries to anchor the file."""
+        """The last line's own ``hash`` field: print it on summaries to anchor the file (it is
+        in the file, so ``grep`` finds it)."""
         return self._replay.last_hash or ""
 
     @property
@@ -340,7 +274,7 @@ class SessionWriter:
             if self._fd is None:
                 raise StationError(f"session file {self.path} is closed; resume it to continue")
             record = {"seq": self._replay.last_seq + 1, "t": utc_now_iso(), "type": type, **fields}
-            line = encode_line(record, self._replay.last_hash)
+            line = encode_line(record, self._replay.chain_hash)
             stored = decode_line(line)
             try:
                 self._replay.check(stored)

@@ -8,12 +8,16 @@ is the header, every later line one event. Each line ends with two fields, in th
 - ``"hash"``: the sha256 (hex) of this line's own bytes up to, not including, the
   ``,"hash":"`` that introduces it. An edit of any line, the last one included, breaks it.
 
-The *last hash* of a file is the sha256 of its last line's bytes; it is printed on every summary
-and report so that a filed report anchors its session file (a chain alone cannot stop someone
-who rewrites every later line too). Events carry ``seq`` (1, 2, 3 ... after the header),
-``t`` (the wall-clock time the event was written, ISO-8601 UTC with microseconds and a ``Z``)
-and ``type``; the fields of each type are checked by :class:`Replay`, which both the writer (before
-it writes) and the loader use, so a file the writer produced always loads.
+The *last hash* of a file is its last line's own ``hash`` field: it covers that line's ``prev``,
+which covers the line before, and so on, so it anchors the whole file as well as a hash of the
+whole line would, and it is a string a quality engineer finds in the file with ``grep``. It is
+printed on every summary and report so that a filed report anchors its session file (a chain
+alone cannot stop someone who rewrites every later line too).
+
+Events carry ``seq`` (1, 2, 3 ... after the header), ``t`` (the wall-clock time the event was
+written, ISO-8601 UTC with microseconds and a ``Z``) and ``type``; the fields of each type are
+checked by :class:`Replay`, which both the writer (before it writes) and the loader use, so a
+file the writer produced always loads.
 
 The writer lives in :mod:`station.session.journal`; ``sessions/README.md`` describes the format
 for people.
@@ -34,6 +38,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from station.errors import StationError
+from station.session.durable import fsync_folder
 
 if TYPE_CHECKING:
     import numpy as np
@@ -232,6 +237,7 @@ class Session:
     (which, for a file nobody is writing, means the writer stopped without a word: a crash)."""
     last_seq: int
     last_hash: str
+    """The last line's own ``hash`` field: the anchor to print (it is in the file)."""
     lines: int
     torn: TornTail | None = None
 
@@ -312,15 +318,33 @@ class Session:
 
         Rejected cycles are left out unless ``include_rejected``; :attr:`excluded_cycles` says
         which. A channel a cycle did not capture is left out of that channel's array.
+        :meth:`channel_cycles` gives the cycle number of each value.
         """
         import numpy as np
 
+        return {
+            channel: np.asarray([value for _, value in column], dtype=float)
+            for channel, column in self._columns(include_rejected).items()
+        }
+
+    def channel_cycles(self, include_rejected: bool = False) -> dict[str, np.ndarray]:
+        """The cycle number of each value :meth:`channel_values` gives, channel by channel:
+        pass both to :func:`station.analysis.summary.analyze` (``cycles=``) so the report and
+        the alarms name cycles, not positions among the accepted readings."""
+        import numpy as np
+
+        return {
+            channel: np.asarray([number for number, _ in column], dtype=int)
+            for channel, column in self._columns(include_rejected).items()
+        }
+
+    def _columns(self, include_rejected: bool) -> dict[str, list[tuple[int, float]]]:
         numbers = sorted(self.cycles) if include_rejected else self.accepted_cycles
-        values: dict[str, list[float]] = {channel: [] for channel in self.channels}
+        columns: dict[str, list[tuple[int, float]]] = {channel: [] for channel in self.channels}
         for number in numbers:
             for channel, reading in self.cycles[number].readings.items():
-                values.setdefault(channel, []).append(reading.value)
-        return {channel: np.asarray(column, dtype=float) for channel, column in values.items()}
+                columns.setdefault(channel, []).append((number, reading.value))
+        return columns
 
 
 # --------------------------------------------------------------------------------------------
@@ -363,6 +387,9 @@ class Replay:
     status: Status = "running"
     last_seq: int = 0
     last_hash: str | None = None
+    """The last line's own ``hash`` field: the anchor printed on summaries and reports."""
+    chain_hash: str | None = None
+    """The sha256 of the last line's bytes: the next line's ``prev``."""
 
     def check(self, record: Mapping[str, Any]) -> None:
         """Raise ValueError naming the fault when ``record`` cannot come next."""
@@ -385,7 +412,8 @@ class Replay:
 
     def apply(self, record: dict[str, Any], line: bytes) -> None:
         """Add a checked record; ``line`` is its bytes on disk (for the chain)."""
-        self.last_hash = line_hash(line)
+        self.chain_hash = line_hash(line)
+        self.last_hash = str(record["hash"])
         if not self.header:
             self.header = record
             return
@@ -628,38 +656,60 @@ def _split(data: bytes) -> _Split:
             # length reached the disk before its data (zeros); an edited line that still decodes
             # but fails its hash is not torn: decode_line tells the two apart.
             last = lines[-1]
-            if not _looks_edited(last):
+            if not _has_hash_suffix(last):
                 lines.pop()
                 return _Split(lines, len(data) - len(last) - 1, "the last line does not parse")
     return _Split(lines, len(data), None)
 
 
-def _looks_edited(line: bytes) -> bool:
-    """True when a line has a well-formed hash suffix whose hash does not match: an edit."""
+def _has_hash_suffix(line: bytes) -> bool:
+    """True when a line ends in ``,"hash":"<64 hex>"}``, whether or not the hash matches."""
     if len(line) <= _HASH_SUFFIX_LENGTH:
         return False
     suffix = line[len(line) - _HASH_SUFFIX_LENGTH :]
     return suffix.startswith(_HASH_PREFIX) and bool(_HEX64.match(suffix[len(_HASH_PREFIX) : -2]))
 
 
+_HEADER_START = b'{"format":"' + FORMAT.encode("ascii") + b'"'
+
+
+def looks_like_session(data: bytes) -> bool:
+    """True when ``data`` (a file's first bytes, at least its first line) begins like a session
+    file: the header's opening ``{"format":"station-session/1"`` (the writer puts it first, so
+    even a header cut short while being created has it), or a first line that ends in a
+    well-formed hash (a session whose header was edited is damaged, not foreign)."""
+    first = data.split(b"\n", 1)[0]
+    return first.startswith(_HEADER_START) or (len(data) > len(first) and _has_hash_suffix(first))
+
+
+def not_a_session_error(path: Path | str, empty: bool = False) -> StationError:
+    """The one sentence for a file that is not a session file at all (exit 2)."""
+    what = "is empty:" if empty else "is"
+    return StationError(
+        f"{path} {what} not a station session file (its first line is not a {FORMAT} header)"
+    )
+
+
 def replay_bytes(data: bytes, path: Path, *, allow_torn: bool) -> tuple[Replay, int, _Split]:
     """Check and replay a file's bytes; SessionFileError naming the first bad line.
 
     Returns the replay, the number of lines replayed and the split (with the torn tail, when
-    ``allow_torn``; otherwise a torn tail is itself the first bad line).
+    ``allow_torn``; otherwise a torn tail is itself the first bad line). Bytes that do not
+    begin like a session file at all (:func:`looks_like_session`) are a plain StationError
+    saying so, not a damaged session.
     """
+    if not looks_like_session(data):
+        raise not_a_session_error(path, empty=not data)
     split = _split(data)
     if split.torn_reason and not allow_torn:
         raise SessionFileError(path, len(split.lines) + 1, f"torn: {split.torn_reason}")
     if not split.lines:
-        if data:
-            raise SessionFileError(path, 1, "no complete header line (cut while being created?)")
-        raise SessionFileError(path, 1, "the file is empty")
+        raise SessionFileError(path, 1, "no complete header line (cut while being created?)")
     replay = Replay()
     for number, line in enumerate(split.lines, start=1):
         try:
             record = decode_line(line)
-            if record.get("prev") != replay.last_hash:
+            if record.get("prev") != replay.chain_hash:
                 raise ValueError(
                     "the hash chain is broken: 'prev' does not match the previous line "
                     "(a line before it was changed, removed or inserted)"
@@ -742,13 +792,15 @@ def _handle_torn(path: Path, data: bytes, split: _Split, recover: bool) -> TornT
             return TornTail(
                 split.kept, len(torn_bytes), None, f"{where} changed while being read; left as is"
             )
-        # Save the torn bytes durably before cutting them from the session file.
+        # Save the torn bytes durably (data and the .torn file's name) before cutting them from
+        # the session file.
         torn_fd = os.open(torn_path, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o640)
         try:
             _write_all(torn_fd, torn_bytes)
             os.fsync(torn_fd)
         finally:
             os.close(torn_fd)
+        fsync_folder(path.parent)
         os.ftruncate(fd, split.kept)
         os.fsync(fd)
     except OSError as error:

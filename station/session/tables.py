@@ -37,6 +37,9 @@ class ReadingTable:
     channels: dict[str, np.ndarray]
     index_columns: tuple[str, ...]
     comments: tuple[str, ...]
+    cycles: np.ndarray | None = None
+    """The ``cycle`` column's whole numbers, one per row (None without one): the analysis
+    numbers the readings by them."""
 
     @property
     def rows(self) -> int:
@@ -123,6 +126,8 @@ def read_table(path: str | Path) -> ReadingTable:
         raise StationError(f"{path} has a header but no readings; add one row per cycle.")
 
     columns: dict[str, list[float]] = {names[i]: [] for i in channel_positions}
+    cycle_position = next((i for i, name in enumerate(names) if name.lower() == "cycle"), None)
+    cycles: list[int] = []
     for line_number, cells in data_rows:
         if len(cells) != len(names):
             raise StationError(
@@ -131,12 +136,23 @@ def read_table(path: str | Path) -> ReadingTable:
             )
         for i in channel_positions:
             columns[names[i]].append(_parse_cell(cells[i], path, line_number, names[i]))
+        if cycle_position is not None:
+            name = names[cycle_position]
+            number = _parse_cell(cells[cycle_position], path, line_number, name)
+            if number != int(number) or number < 1:
+                raise StationError(
+                    f"{path}: line {line_number}, column {name!r}: "
+                    f"{cells[cycle_position].strip()!r} is not a cycle number (1, 2, 3 ...); "
+                    "fix the cell or delete the row."
+                )
+            cycles.append(int(number))
 
     return ReadingTable(
         path=path,
         channels={name: np.asarray(values, dtype=float) for name, values in columns.items()},
         index_columns=tuple(name for name in names if name.lower() in INDEX_COLUMNS),
         comments=tuple(comments),
+        cycles=None if cycle_position is None else np.asarray(cycles, dtype=int),
     )
 
 

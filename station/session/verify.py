@@ -4,16 +4,21 @@ A file is intact when every line decodes, every line's own ``hash`` matches its 
 ``prev`` chain is unbroken, ``seq`` counts up from 1, every event is well formed, and the file
 ends with a newline (a torn tail is reported as the first bad line: loading or resuming the
 session moves it aside, after which the file verifies). The summary carries the last line's
-hash, which anchors the file: a filed report that quotes it shows whether the file changed.
+own ``hash`` field, which anchors the file: a filed report that quotes it shows whether the file
+changed, and ``grep`` finds it in the file. A file that is not a session file at all (a CSV
+table, an empty file) is a StationError saying so (exit 2), not a damaged session.
 """
 
 from __future__ import annotations
 
 import os
+import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 
 from station.session.model import SessionFileError, read_session_bytes, replay_bytes
+
+_WIDTH = 79
 
 
 @dataclass(frozen=True)
@@ -27,10 +32,23 @@ class VerifyResult:
     events: int
     cycles: int
     last_hash: str
-    """The sha256 of the last intact line ('' when not even the header is)."""
+    """The last intact line's own ``hash`` field ('' when not even the header is intact)."""
     first_bad_line: int | None
     message: str
-    """One line for the terminal."""
+    """The verdict after the file's name: ``intact: 6 lines, ...`` or ``NOT intact: line 3:
+    <fault>``."""
+
+    @property
+    def report(self) -> str:
+        """What ``station verify`` prints, for an 80-column terminal: ``<file>: intact`` (or
+        ``NOT intact``), the details wrapped below, and, when intact, ``last hash: <hash>`` on
+        a line of its own (only a very long file name makes a line longer)."""
+        verdict, _, details = self.message.partition(": ")
+        lines = [f"{self.path}: {verdict}"]
+        lines += textwrap.wrap(details, width=_WIDTH, subsequent_indent="  ")
+        if self.ok:
+            lines.append(f"last hash: {self.last_hash}")
+        return "\n".join(lines)
 
 
 def verify_session(path: str | os.PathLike[str]) -> VerifyResult:
@@ -60,7 +78,7 @@ def verify_session(path: str | os.PathLike[str]) -> VerifyResult:
             cycles=len(replay.cycles) if replay else 0,
             last_hash=(replay.last_hash or "") if replay else "",
             first_bad_line=error.line,
-            message=f"{path}: NOT intact: line {error.line}: {error.fault}",
+            message=f"NOT intact: line {error.line}: {error.fault}",
         )
     rejected = f", {len(replay.rejected)} rejected" if replay.rejected else ""
     return VerifyResult(
@@ -72,8 +90,7 @@ def verify_session(path: str | os.PathLike[str]) -> VerifyResult:
         last_hash=replay.last_hash or "",
         first_bad_line=None,
         message=(
-            f"{path}: intact: {lines} lines, {len(replay.events)} events, "
-            f"{len(replay.cycles)} cycles{rejected}, {replay.status}; "
-            f"last hash {replay.last_hash}"
+            f"intact: {lines} lines, {len(replay.events)} events, "
+            f"{len(replay.cycles)} cycles{rejected}, {replay.status}"
         ),
     )

@@ -18,6 +18,7 @@ analysis) load when first needed, so the first screen appears fast.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import signal
 import threading
 import time
@@ -59,6 +60,9 @@ class DemoPort:
     procedure: str = "repeatability"
     robot: str = "demo-robot"
     description: str = "simulated dial indicators (seeded)"
+    trigger: str = "poll"
+    count: int | None = None
+    """Cycles, placements or strokes to pre-fill in the set-up (None: the procedure's)."""
 
 
 @dataclass(frozen=True)
@@ -70,6 +74,8 @@ class StationConfig:
     """Why this folder (``--sessions``, ``STATION_SESSIONS``, ``./sessions``, the data folder)."""
     procedure_dirs: tuple[Path, ...] = ()
     demo: DemoPort | None = None
+    demo_lab: Any = None
+    """The demo's simulators per procedure (``station.tui.instruments.DemoLab``), or None."""
     autopilot: bool = False
     autopilot_pace: float = 0.2
     """Seconds between two autopilot actions (a cycle every ``autopilot_pace`` seconds)."""
@@ -102,6 +108,11 @@ class StationApp(App[int]):
         """Called after each redraw with the oldest pending event's stamp (for the benchmark)."""
         self._signals_installed: list[int] = []
         self._warmed_up = False
+        self.demo_fixture: Any = None
+        """The demo's simulator the running session talks to (its pendant), or None."""
+        self.sample_sink: Callable[[Any], None] | None = None
+        """Hears each ``samples`` event on the writing thread (the stroke dashboard's buffer of
+        the stroke under way); it must only store, never draw."""
 
     # ---------------------------------------------------------------------------------------
     # Start and stop
@@ -179,11 +190,37 @@ class StationApp(App[int]):
             self._catalog = discover_procedures(self.config.procedure_dirs)
         return self._catalog
 
+    def demo_port(self, procedure_id: str | None) -> DemoPort | None:
+        """The demo's simulated set-up for ``procedure_id`` (each procedure has its own
+        simulator: two fixtures and a pendant, a bar, one fixture), or None outside the demo."""
+        demo = self.config.demo
+        lab = self.config.demo_lab
+        if demo is None or lab is None or procedure_id in (None, demo.procedure):
+            return demo
+        fixture = lab.fixture(procedure_id)
+        return DemoPort(
+            url=fixture.url,
+            protocol=fixture.protocol,
+            channel_map=dict(fixture.channel_map),
+            procedure=str(procedure_id),
+            robot=demo.robot,
+            description=fixture.description,
+            trigger=fixture.trigger,
+            count=demo.count,
+        )
+
+    def _find_demo_fixture(self, setup: SessionSetup) -> None:
+        lab = self.config.demo_lab
+        urls = [port.url for port in setup.ports]
+        found = [lab.by_url(url) for url in urls] if lab is not None else []
+        self.demo_fixture = next((f for f in found if f is not None), None)
+
     def start_session(self, setup: SessionSetup) -> None:
         """Open the instruments and start a new session; raises StationError with a sentence."""
         from station.runner import Runner
 
         self.warm_up_analysis()
+        self._find_demo_fixture(setup)
         self._open_instruments(setup)
         try:
             self.runner = Runner.start(
@@ -221,6 +258,7 @@ class StationApp(App[int]):
 
         setup = resume_setup(path, procedures_dirs=self.config.procedure_dirs, ports=ports)
         self.warm_up_analysis()
+        self._find_demo_fixture(setup)
         self._open_instruments(setup)
         try:
             self.runner = Runner.resume(
@@ -244,6 +282,10 @@ class StationApp(App[int]):
             and state.cycle >= state.cycles_min
         ):
             runner.confirm()
+        elif state.current is not None and state.current.kind == "stroke" and state.strokes:
+            # Below the step's minimum the runner refuses; the session then ends incomplete.
+            with contextlib.suppress(StationError):
+                runner.confirm()
         analysis = runner.finish()
         state = runner.state()
         self.close_instruments()
@@ -260,7 +302,14 @@ class StationApp(App[int]):
         """Called on the thread that produced the event: store the state, post a message."""
         with self._state_lock:
             self._latest_state = notice.state
+        fixture = self.demo_fixture
+        if fixture is not None:
+            # The simulated robot goes where the procedure says (its pendant follows).
+            fixture.at_placement(notice.state.placement)
         event_type = str((notice.event or {}).get("type", "")) if notice.event else ""
+        sink = self.sample_sink
+        if sink is not None and event_type == "samples":
+            sink(notice.event)
         self.post_message(RunnerChanged(event_type=event_type, posted_at=time.monotonic()))
 
     def on_runner_changed(self, message: RunnerChanged) -> None:
@@ -318,12 +367,15 @@ class StationApp(App[int]):
 
         if state.status in ("finished", "interrupted", "failed"):
             return False
-        wants_dashboard = state.current is None or state.current.kind in (
-            "capture",
-            "cycles",
-            "stroke",
-        )
         screen = self.screen
+        if state.current is not None and state.current.kind == "stroke":
+            from station.tui.screens.strokes import StrokeDashboardScreen
+
+            if not isinstance(screen, StrokeDashboardScreen):
+                self._replace_run_screen(StrokeDashboardScreen())
+                return True
+            return False
+        wants_dashboard = state.current is None or state.current.kind in ("capture", "cycles")
         if wants_dashboard and not isinstance(screen, DashboardScreen):
             self._replace_run_screen(DashboardScreen(live=True))
             return True

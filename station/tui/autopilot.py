@@ -1,8 +1,10 @@
 """``station demo --autopilot``: walk the procedure by itself, through the operator's own actions.
 
 Each move is what a key would do on the screen in front (Enter on the home screen's first new
-session, F2 on the set-up, Enter on each checklist step, Space for each cycle, ``r`` with a
-reason once, ``f`` at the end), at a watchable pace, and the walk stops on the summary. Nothing
+session, F2 on the set-up, Enter on each checklist step, typing the simulated teach pendant's
+X, Y, Z at an input step, Space for each cycle or capture, ``r`` with a reason once, streaming
+the strokes of a linearity run, ``f`` at the end), at a watchable pace, and the walk stops on the
+summary. Nothing
 is faked: the runner, the instruments and the session file are the real ones.
 """
 
@@ -26,6 +28,7 @@ async def run_autopilot(app: StationApp) -> None:
     from station.tui.screens.dashboard import DashboardScreen
     from station.tui.screens.home import HomeScreen
     from station.tui.screens.setup import SetupScreen
+    from station.tui.screens.strokes import StrokeDashboardScreen
     from station.tui.screens.summary import SummaryScreen
 
     pace = app.config.autopilot_pace
@@ -37,6 +40,8 @@ async def run_autopilot(app: StationApp) -> None:
         screen = app.screen
         if isinstance(screen, SummaryScreen):
             return
+        if not screen.is_mounted or not screen.query("Footer"):
+            continue  # switched to, not composed yet: its keys would find no widgets
         if isinstance(screen, HomeScreen) and not opened:
             await asyncio.sleep(step_pause)
             opened = True
@@ -48,8 +53,16 @@ async def run_autopilot(app: StationApp) -> None:
         elif isinstance(screen, ChecklistScreen):
             await asyncio.sleep(step_pause)
             if app.screen is screen and not screen.busy:
-                _fill_inputs(screen)
+                _fill_inputs(app, screen)
                 screen.action_confirm()
+        elif isinstance(screen, StrokeDashboardScreen):
+            state = app.current_state()
+            if state is None or screen.streaming or state.status != "running":
+                continue
+            if state.strokes >= state.strokes_target:
+                screen.action_finish()
+            else:
+                screen.action_stream()
         elif isinstance(screen, DashboardScreen) and screen.live:
             state = app.current_state()
             if state is None or screen.busy:
@@ -72,10 +85,17 @@ async def run_autopilot(app: StationApp) -> None:
                 screen.action_finish()
 
 
-def _fill_inputs(screen: object) -> None:
-    """Type a demo value into empty input fields (a teach pendant would show these)."""
+def _fill_inputs(app: StationApp, screen: object) -> None:
+    """Type into the empty input fields what the simulated teach pendant shows (X, Y, Z into
+    the fields named x, y, z), else a demo value."""
     from textual.widgets import Input
 
+    state = app.current_state()
+    fixture = app.demo_fixture
+    placement = state.current.placement if state is not None and state.current else None
+    shown = fixture.pendant(placement) if fixture is not None else None
+    pendant = dict(zip("xyz", shown.pendant, strict=True)) if shown is not None else {}
     for widget in screen.query("#step-inputs Input"):  # type: ignore[attr-defined]
         if isinstance(widget, Input) and not widget.value:
-            widget.value = "0"
+            name = str(widget.id).removeprefix("input-")
+            widget.value = str(pendant[name]) if name in pendant else "0"

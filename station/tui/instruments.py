@@ -14,17 +14,44 @@ from station.errors import StationError
 
 DEMO_PROTOCOL = "mitutoyo"
 DEMO_CHANNEL_MAP = {"1": "x", "2": "y", "3": "z"}
+BAR_CHANNEL_MAP = {"1": "h", "2": "v", "3": "s"}
+BAR_PUSH_RATE = 200.0
+"""Sets a second the simulated bar's indicators and scale send (a linear-scale counter's rate)."""
 TEST_CAPTURES = 5
+
+DEMO_PROCEDURES = {
+    "repeatability": "three dial indicators in one fixture",
+    "relative_accuracy": "two fixtures far apart, with a teach pendant",
+    "linearity": "a parallel bar: indicators h, v and a linear scale s",
+}
+"""The procedures ``station demo`` simulates, with the set-up each one's simulator models."""
 
 
 @dataclass
 class DemoFixture:
-    """A running simulated fixture: its URL and the simulator to stop."""
+    """A running simulated set-up: its URL, how to talk to it, and the simulator to stop."""
 
     url: str
     protocol: str
     channel_map: dict[str, str]
     simulator: Any
+    procedure: str = "repeatability"
+    trigger: str = "poll"
+    description: str = "simulated dial indicators (seeded)"
+
+    def pendant(self, placement: int | None) -> Any:
+        """What the simulated teach pendant shows at ``placement`` (a ``Placement`` with
+        ``pendant`` and ``pendant_text()``), or None when this set-up has no pendant."""
+        placement_of = getattr(self.simulator.model, "placement_of", None)
+        if placement_of is None or placement is None:
+            return None
+        return placement_of(placement)
+
+    def at_placement(self, placement: int | None) -> None:
+        """Tell the two-fixture model where the robot is (the pendant shown then follows)."""
+        model = self.simulator.model
+        if placement is not None and hasattr(model, "placement_of"):
+            model.placement = placement
 
     def stop(self) -> None:
         """Close the pseudo-terminal and stop the simulator's thread."""
@@ -32,29 +59,98 @@ class DemoFixture:
 
 
 def start_demo_fixture(
-    seed: int = 1990, *, unit: str = "in", resolution: float = 0.0001, link: str | None = None
+    seed: int = 1990,
+    *,
+    procedure: str = "repeatability",
+    unit: str = "in",
+    resolution: float = 0.0001,
+    link: str | None = None,
+    stroke_points: int = 400,
 ) -> DemoFixture:
-    """Start the simulator on a pseudo-terminal: a robot that repeats well in x, sits a little
-    off nominal in y, and warms up (drifts) in z, so the demo shows each kind of verdict and a
-    control-chart alarm. Deterministic for a seed. ``link``: a fixed path for the pty (a
-    symlink), instead of ``/dev/pts/N``."""
-    from station.instruments.protocols import get_protocol
-    from station.instruments.simulator import AxisModel, FixtureModel, GaugeSpec, Simulator
+    """Start the simulator of ``procedure``'s set-up on a pseudo-terminal, seeded.
 
-    model = FixtureModel(
-        {
-            "x": AxisModel(bias=0.0, noise=0.00022),
-            "y": AxisModel(bias=0.00025, noise=0.00036, skew=2.0),
-            "z": AxisModel(bias=-0.0002, noise=0.00012, drift=0.0005, drift_tau=6.0),
-        },
-        GaugeSpec(resolution=resolution, low=-0.5, high=0.5, unit=unit),
+    * repeatability (and any other procedure): a robot that repeats well in x, sits a little
+      off nominal in y, and warms up (drifts) in z, so the demo shows each kind of verdict and
+      a control-chart alarm;
+    * relative_accuracy: two fixtures with a pendant display, an error that grows with the
+      distance moved, and a preload at home that only zeroing takes out;
+    * linearity: a bar with a bow, a sag and a linear scale, a robot path with a wobble,
+      pushing ``BAR_PUSH_RATE`` sets a second; ``stroke_points`` points per stroke.
+
+    ``link``: a fixed path for the pty (a symlink), instead of ``/dev/pts/N``.
+    """
+    from station.instruments.protocols import get_protocol
+    from station.instruments.simulator import (
+        AxisModel,
+        BarModel,
+        FixtureModel,
+        GaugeSpec,
+        Simulator,
+        TwoFixtureModel,
     )
+
     protocol = get_protocol(DEMO_PROTOCOL)
-    simulator = Simulator(protocol, model, seed=seed, channel_map=DEMO_CHANNEL_MAP)
+    gauge = GaugeSpec(resolution=resolution, low=-0.5, high=0.5, unit=unit)
+    channel_map, trigger, push_rate = DEMO_CHANNEL_MAP, "poll", 0.0
+    if procedure == "relative_accuracy":
+        # Mitutoyo has no zero command: the station zeroes in software, reading one set at
+        # home per placement, so the preload really has to be zeroed out.
+        model: Any = TwoFixtureModel(home_readings=1, preload=0.05, gauge=gauge, seed=seed)
+        description = "two simulated fixtures and a teach pendant (seeded)"
+    elif procedure == "linearity":
+        model = BarModel(points=stroke_points, indicator=gauge)
+        channel_map, trigger, push_rate = BAR_CHANNEL_MAP, "push", BAR_PUSH_RATE
+        description = "a simulated parallel bar with indicators h, v and a scale s (seeded)"
+    else:
+        model = FixtureModel(
+            {
+                "x": AxisModel(bias=0.0, noise=0.00022),
+                "y": AxisModel(bias=0.00025, noise=0.00036, skew=2.0),
+                "z": AxisModel(bias=-0.0002, noise=0.00012, drift=0.0005, drift_tau=6.0),
+            },
+            gauge,
+        )
+        description = "simulated dial indicators (seeded)"
+    simulator = Simulator(protocol, model, seed=seed, channel_map=channel_map, push_rate=push_rate)
     url = simulator.start_pty(link=link)
     return DemoFixture(
-        url=url, protocol=DEMO_PROTOCOL, channel_map=dict(DEMO_CHANNEL_MAP), simulator=simulator
+        url=url,
+        protocol=DEMO_PROTOCOL,
+        channel_map=dict(channel_map),
+        simulator=simulator,
+        procedure=procedure,
+        trigger=trigger,
+        description=description,
     )
+
+
+class DemoLab:
+    """The demo's simulators, one per procedure, each started the first time it is asked for
+    (so the set-up's procedure picker switches the simulated set-up with the procedure)."""
+
+    def __init__(self, seed: int = 1990, *, stroke_points: int = 400) -> None:
+        self.seed = seed
+        self.stroke_points = stroke_points
+        self._fixtures: dict[str, DemoFixture] = {}
+
+    def fixture(self, procedure: str) -> DemoFixture:
+        """The running simulator for ``procedure`` (a fixture model for unknown ones)."""
+        key = procedure if procedure in DEMO_PROCEDURES else "repeatability"
+        if key not in self._fixtures:
+            self._fixtures[key] = start_demo_fixture(
+                self.seed, procedure=key, stroke_points=self.stroke_points
+            )
+        return self._fixtures[key]
+
+    def by_url(self, url: str) -> DemoFixture | None:
+        """The running simulator on ``url``, if it is one of the demo's."""
+        return next((f for f in self._fixtures.values() if f.url == url), None)
+
+    def stop(self) -> None:
+        """Stop every simulator started."""
+        fixtures, self._fixtures = list(self._fixtures.values()), {}
+        for fixture in fixtures:
+            fixture.stop()
 
 
 def gauge_set(ports: Sequence[Any], trigger: str, **options: Any) -> Any:

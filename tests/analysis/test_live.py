@@ -177,7 +177,36 @@ def test_live_alarms_name_the_point_in_the_whole_chart():
     assert len(values) > RULE_WINDOW
     (alarm,) = update.alarms
     assert alarm.rule == "report-1" and alarm.points == (31,)
-    assert alarm.text.startswith("Point 31 is above the upper control limit")
+    assert alarm.text.startswith("Cycle 31 is above the upper control limit")
+
+
+def test_live_alarms_name_cycle_numbers_as_the_batch_does():
+    """Review finding 9: after a rejected cycle, the 6th reading is cycle 7, not "point 6"."""
+    values = [0.0, 1.0, -1.0, 0.5, -0.5] * 6 + [25.0]
+    cycles = [n for n in range(1, len(values) + 2) if n != 3]
+    live = LiveAnalysis(AnalysisConfig(), channels=("x",))
+    for value, cycle in zip(values, cycles, strict=True):
+        update = live.add_set({"x": value}, cycle=cycle)["x"]
+    (alarm,) = update.alarms
+    assert alarm.points == (31,) and alarm.cycles == (32,)
+    assert alarm.text.startswith("Cycle 32 is above the upper control limit")
+    assert live.snapshot() == analyze(
+        {"x": np.array(values)}, AnalysisConfig(), cycles={"x": cycles}
+    )
+    (batch,) = live.snapshot().channels["x"].alarms
+    assert batch.cycles == (32,) and batch.text == alarm.text
+
+
+def test_live_subgroup_alarms_list_the_cycles_of_their_subgroups():
+    values = [0.0, 1.0, -1.0, 0.5, -0.5, 0.2] * 5 + [25.0, 25.0, 25.0]
+    cycles = list(range(101, 101 + len(values)))
+    config = AnalysisConfig(subgroup=3)
+    live = LiveChannel("x", config)
+    for value, cycle in zip(values, cycles, strict=True):
+        update = live.add(value, cycle)
+    (alarm,) = [a for a in update.alarms if a.rule == "report-1"]
+    assert alarm.points == (11,) and alarm.cycles == (131, 132, 133)
+    assert live.snapshot() == analyze_channel("x", np.array(values), config, cycles)
 
 
 def test_the_snapshot_is_cached_until_the_next_reading():

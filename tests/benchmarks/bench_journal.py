@@ -18,7 +18,8 @@ import time
 from pathlib import Path
 
 from station.procedures import discover_procedures
-from station.session.journal import SessionWriter, session_header
+from station.runner import PortSetup, SessionSetup
+from station.session.journal import SessionWriter
 from station.session.model import decode_line, encode_line, load_session
 
 
@@ -67,7 +68,8 @@ def main() -> None:
     parser.add_argument("--dir", default=None, help="folder on the disk to measure (default: tmp)")
     args = parser.parse_args()
     procedure = discover_procedures(use_env=False).get("repeatability")
-    header = session_header(procedure, robot="bench")
+    port = PortSetup("loop://", "mitutoyo", {"1": "x", "2": "y", "3": "z"})
+    header = SessionSetup(procedure, "bench", "", (port,)).header_fields()
 
     with tempfile.TemporaryDirectory(dir=args.dir) as folder:
         # Baseline: the same bytes, os.write without fsync.

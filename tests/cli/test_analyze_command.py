@@ -134,7 +134,7 @@ BAD_INPUTS = {
     "nan cell": (["{nan_cell}"], "line 2, column 'y': 'nan' is not a finite number"),
     "duplicate column": (["{twice}"], "column 'x' appears twice"),
     "header only": (["{header_only}"], "has a header but no readings"),
-    "not a session": (["{not_session}"], "other.jsonl: line 1:"),
+    "not a session": (["{not_session}"], "other.jsonl is not a station session file"),
     "no channel column": (["{no_channel}"], "no channel columns"),
     "usl below lsl": (["{table}", "--lsl", "0.002", "--usl", "0.001"], "is not above lower"),
     "limit for an unknown channel": (["{table}", "--limit", "q=-1:1"], "channel 'q'"),
@@ -217,3 +217,63 @@ def test_a_session_file_is_analysed_without_its_rejected_cycles(tmp_path):
     assert document["unit"] == "in" and document["resolution"] == 0.0001
     text = station(path).stdout
     assert "Excluded (rejected) cycles: 7" in text and "Last line hash" in text
+
+
+def _pieces(text: str) -> dict[int, str]:
+    """PIECE -> MEASUREMENT of the first channel's readings block of a text report."""
+    lines = text.splitlines()
+    start = next(i for i, line in enumerate(lines) if "PIECE  MEASUREMENT" in line) + 1
+    block = lines[start : lines.index("", start)]
+    cells = " ".join(block).split()
+    return {int(cells[i]): cells[i + 1] for i in range(0, len(cells) - 1, 2)}
+
+
+def test_pieces_and_alarms_are_named_by_cycle_number(tmp_path):
+    """Review finding 9: with cycle 3 rejected, the outlier of cycle 7 was "PIECE 6", its
+    alarm "point 6" and the hint "report-1 at point 6"."""
+    from station.session.journal import SessionWriter
+
+    header = {
+        "robot": "cell-3",
+        "procedure": {"id": "repeatability", "version": "1", "sha256": "0" * 64},
+        "channels": ["x"],
+        "unit": "in",
+        "resolution": 0.0001,
+        "limits": {"x": {"lsl": -0.01, "usl": 0.01, "nominal": 0.0}},
+    }
+    values = [0.0001, -0.0001, 0.0002, 0.0, 0.0001, -0.0002, 0.0060] + [0.0001, -0.0001] * 10
+    with SessionWriter.create(tmp_path, header) as writer:
+        for cycle, value in enumerate(values, start=1):
+            writer.append("reading", cycle=cycle, channels={"x": {"value": value}})
+        writer.append("reject", cycle=3, reason="fixture bumped")
+        path = writer.path
+    document = json.loads(station(path, "--json").stdout)
+    x = document["channels"]["x"]
+    assert x["cycles"] == [1, 2, *range(4, len(values) + 1)]
+    (alarm,) = [a for a in x["alarms"] if a["rule"] == "report-1"]
+    assert alarm["points"] == [6] and alarm["cycles"] == [7]
+    assert alarm["text"].startswith("Cycle 7 is above the upper control limit")
+    assert any("report-1 at cycle 7;" in hint for hint in document["hints"])
+
+    text = station(path).stdout
+    pieces = _pieces(text)
+    assert 3 not in pieces and pieces[7] == "+0.00600" and pieces[6] == "-0.00020"
+    assert "report-1: Cycle 7 is above" in text
+
+
+def test_a_csv_cycle_column_numbers_the_readings(tmp_path):
+    rows = ["cycle,x"] + [f"{10 + n},{v}" for n, v in enumerate([0.0, 0.1, -0.1] * 8 + [9.0])]
+    path = write_csv(tmp_path, "numbered.csv", "\n".join(rows) + "\n")
+    document = json.loads(station(path, "--json").stdout)
+    assert document["channels"]["x"]["cycles"] == list(range(10, 35))
+    (alarm,) = document["channels"]["x"]["alarms"]
+    assert alarm["cycles"] == [34] and alarm["text"].startswith("Cycle 34 ")
+    assert _pieces(station(path).stdout)[34] == "+9.00"
+    unnumbered = write_csv(
+        tmp_path, "plain.csv", "x\n" + "\n".join(r.split(",")[1] for r in rows[1:])
+    )
+    plain = json.loads(station(unnumbered, "--json").stdout)["channels"]["x"]
+    assert plain["cycles"] == list(range(1, 26)) and plain["alarms"][0]["cycles"] == [25]
+    bad = write_csv(tmp_path, "bad.csv", "cycle,x\n1,0.1\n2.5,0.2\n")
+    result = station(bad)
+    assert result.returncode == 2 and "'2.5' is not a cycle number" in result.stderr

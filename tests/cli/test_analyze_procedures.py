@@ -155,10 +155,13 @@ def test_bad_tolerance_is_a_one_line_error(linearity_csv, args, fault):
 def write_session(folder: Path, procedure_id: str, events: list[tuple[str, dict]]) -> Path:
     """A real, hash-chained session file of the built-in procedure ``procedure_id``."""
     from station.procedures import builtin_procedures_dir, load_procedure
-    from station.session.journal import SessionWriter, session_header
+    from station.runner import PortSetup, SessionSetup
+    from station.session.journal import SessionWriter
 
     procedure = load_procedure(builtin_procedures_dir() / f"{procedure_id}.toml")
-    header = session_header(procedure, robot="sim", operator="F")
+    channel_map = {str(n): ch for n, ch in enumerate(procedure.channels, start=1)}
+    port = PortSetup("loop://", "mitutoyo", channel_map)
+    header = SessionSetup(procedure, "sim", "F", (port,)).header_fields()
     with SessionWriter.create(folder, header) as writer:
         for kind, fields in events:
             writer.append(kind, **fields)
@@ -240,3 +243,67 @@ def test_a_linearity_session_without_samples_says_so(tmp_path):
     result = station(path)
     assert result.returncode == 2
     assert "no streamed strokes" in result.stderr
+
+
+def test_a_site_procedure_is_analysed_by_its_declared_kind(tmp_path, monkeypatch):
+    """Review finding 17: a site's `relative_accuracy_site` was analysed as repeatability
+    because analyze chose the analysis by the procedure's id."""
+    from station.procedures import builtin_procedures_dir, load_procedure
+    from station.runner import PortSetup, SessionSetup
+    from station.session.journal import SessionWriter
+
+    site = tmp_path / "site"
+    site.mkdir()
+    text = (builtin_procedures_dir() / "relative_accuracy.toml").read_text()
+    (site / "ra.toml").write_text(
+        text.replace('id = "relative_accuracy"', 'id = "relative_accuracy_site"')
+    )
+    procedure = load_procedure(site / "ra.toml")
+    assert procedure.analysis == "relative_accuracy"
+    port = PortSetup("loop://", "mitutoyo", {"1": "x", "2": "y", "3": "z"})
+    header = SessionSetup(procedure, "cell 9", "F", (port,)).header_fields()
+    with SessionWriter.create(tmp_path / "sessions", header) as writer:
+        for placement in range(1, 4):
+            readings = {axis: {"value": 0.0001 * placement} for axis in "xyz"}
+            writer.append(
+                "reading", cycle=placement, step="return", placement=placement, channels=readings
+            )
+        path = writer.path
+    # The reviewing machine need not have the site's procedure file: the session says enough.
+    monkeypatch.delenv("STATION_PROCEDURES", raising=False)
+    result = station(path, "--json")
+    assert result.returncode == 0, result.stderr
+    document = json.loads(result.stdout)
+    assert document["procedure"] == "relative_accuracy"
+    assert [p["placement"] for p in document["accuracy"]["placements"]] == [1, 2, 3]
+
+
+def test_the_analysis_a_header_records_wins(tmp_path, capsys):
+    """A header that records its procedure's analysis (``procedure.analysis``) is analysed so,
+    whatever the session holds."""
+    from station.cli import main
+    from station.session.journal import SessionWriter
+
+    header = {
+        "robot": "cell 9",
+        "procedure": {"id": "site_a", "version": "1", "sha256": "0" * 64},
+        "channels": ["x", "y", "z"],
+        "unit": "in",
+    }
+    header["procedure"]["analysis"] = "repeatability"
+    with SessionWriter.create(tmp_path, header) as writer:
+        for cycle in range(1, 4):
+            readings = {axis: {"value": 0.0001 * cycle} for axis in "xyz"}
+            writer.append("reading", cycle=cycle, placement=cycle, channels=readings)
+        path = writer.path
+    assert main(["analyze", str(path), "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    assert document["procedure"] == "repeatability" and "accuracy" not in document
+    header["procedure"]["analysis"] = "relative_accuracy"
+    with SessionWriter.create(tmp_path, header) as writer:
+        for cycle in range(1, 4):
+            readings = {axis: {"value": 0.0001 * cycle} for axis in "xyz"}
+            writer.append("reading", cycle=cycle, channels=readings)
+        path = writer.path
+    assert main(["analyze", str(path)]) == 2
+    assert "no accepted readings at a fixture placement" in capsys.readouterr().err

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import signal
 import subprocess
 import sys
@@ -99,7 +100,7 @@ def test_a_rejected_frame_gets_its_line() -> None:
     assert [r["value"] for r in readings] == pytest.approx(sim.sent_values("x")[:4])
     assert text.returncode == 0, text.stderr
     assert "rejected (error): " in text.stdout and "[ERR0]" in text.stdout
-    assert f"{sim.sent_values('x')[4]:+.6g} mm" in text.stdout
+    assert f"{sim.sent_values('x')[4]:+.3f} mm" in text.stdout
 
 
 def test_push_protocol_prints_readings_as_they_arrive() -> None:
@@ -115,6 +116,32 @@ def test_push_protocol_prints_readings_as_they_arrive() -> None:
     # Unmapped: the device's own channel numbers, each line with value, unit and raw frame.
     assert lines[0].split()[0] in {"1", "2", "3"}
     assert all(" mm  DT1" in line for line in lines)
+    # Review finding 14: every value at the resolution's decimals ("+0.000", never "+0").
+    assert all(re.fullmatch(r"[+-]\d+\.\d{3}", line.split()[1]) for line in lines), lines
+
+
+def test_a_zero_reading_keeps_its_decimals() -> None:
+    """Review finding 14: {value:+.6g} printed "+0 mm" beside "-0.001 mm"."""
+    model = fixture_model(["x", "y", "z"], axis=AxisModel(bias=0.0, noise=0.0))
+    sim = Simulator(get_protocol("uwave"), model, None, seed=13, push_rate=40)
+    url = sim.start_tcp(0)
+    try:
+        result = station("read", "--port", url, "--protocol", "uwave", "--count", "3")
+    finally:
+        sim.stop()
+    assert result.returncode == 0, result.stderr
+    assert [line.split()[1:3] for line in result.stdout.splitlines()] == [["+0.000", "mm"]] * 3
+
+
+def test_values_are_shown_at_the_resolutions_decimals() -> None:
+    from station.commands.read import value_text
+
+    assert value_text(0.0, 0.001) == "+0.000"
+    assert value_text(-0.001, 0.001) == "-0.001"
+    assert value_text(0.0001, 0.0001) == "+0.0001"
+    assert value_text(12.5, 0.01) == "+12.50"
+    # A gauge finer than --resolution keeps its digits rather than being rounded.
+    assert value_text(0.0012, 0.001) == "+0.0012"
 
 
 @pytest.mark.parametrize(

@@ -116,3 +116,43 @@ def test_bad_options_exit_2_with_a_sentence(args: list[str], sentence: str) -> N
     assert sentence in result.stderr
     assert result.stdout == ""
     assert "Traceback" not in result.stderr
+
+
+def test_link_refuses_to_replace_a_file(tmp_path) -> None:
+    """Review finding 10: --link PATH used to overwrite PATH, and unlink it on exit."""
+    precious = tmp_path / "notes.txt"
+    precious.write_text("keep me")
+    result = subprocess.run(
+        [*STATION, "simulate", "--protocol", "mitutoyo", "--link", str(precious)],
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert result.returncode == 2
+    assert result.stderr.startswith(f"station: {precious} exists and is not a simulator's link")
+    assert precious.read_text() == "keep me"
+
+
+def test_link_replaces_a_stale_simulator_link(tmp_path) -> None:
+    link = tmp_path / "gauge"
+    link.symlink_to("/dev/pts/999999")  # what a killed simulator leaves behind
+    process, url = start("--protocol", "mitutoyo", "--link", str(link))
+    assert url == str(link) and link.resolve() != "/dev/pts/999999"
+    assert len(poll(url, "mitutoyo", 1)) == 1
+    code, err = finish(process, signal.SIGTERM)
+    assert code == 0, err
+    assert not link.is_symlink()
+
+
+@pytest.mark.parametrize("sig", [signal.SIGHUP, signal.SIGINT, signal.SIGTERM])
+def test_a_hang_up_cleans_up_like_sigterm(sig: int) -> None:
+    """Review finding 10: after SIGHUP (an SSH session closing) the /tmp/station-sim-* folder
+    of the disconnect link was left behind."""
+    from pathlib import Path
+
+    process, url = start("--protocol", "mitutoyo", "--disconnect-every", "30")
+    folder = Path(url).parent
+    assert folder.name.startswith("station-sim-") and folder.is_dir()
+    code, err = finish(process, sig)
+    assert code == 0, err
+    assert not folder.exists()

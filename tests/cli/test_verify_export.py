@@ -13,12 +13,14 @@ import pytest
 
 from station.cli import main
 from station.procedures import discover_procedures
-from station.session.journal import SessionWriter, session_header
+from station.runner import PortSetup, SessionSetup
+from station.session.journal import SessionWriter
 
 
 def make_session(folder: Path, cycles: int = 3) -> Path:
     procedure = discover_procedures(use_env=False).get("repeatability")
-    header = session_header(procedure, robot="cell 4", operator="ana")
+    port = PortSetup("loop://", "mitutoyo", {"1": "x", "2": "y", "3": "z"})
+    header = SessionSetup(procedure, "cell 4", "ana", (port,)).header_fields()
     moment = datetime(2026, 11, 23, 9, 30, tzinfo=UTC)
     with SessionWriter.create(folder, header, now=moment) as writer:
         for cycle in range(1, cycles + 1):
@@ -43,11 +45,11 @@ def test_verify_exit_codes_through_the_real_cli(tmp_path: Path) -> None:
     path = make_session(tmp_path)
     intact = station("verify", str(path))
     assert intact.returncode == 0, intact.stderr
-    (line,) = intact.stdout.splitlines()
-    assert "intact" in line and "3 cycles, 1 rejected" in line
+    verdict, line, anchor = intact.stdout.splitlines()
+    assert verdict == f"{path}: intact" and "3 cycles, 1 rejected" in line
     from station.session.model import load_session
 
-    assert line.endswith(f"last hash {load_session(path, recover=False).last_hash}")
+    assert anchor == f"last hash: {load_session(path, recover=False).last_hash}"
 
     data = bytearray(path.read_bytes())
     for line_number in (1, 3, 6):  # header, a reading, the finish line
@@ -58,7 +60,8 @@ def test_verify_exit_codes_through_the_real_cli(tmp_path: Path) -> None:
         target.write_bytes(bytes(damaged))
         result = station("verify", str(target))
         assert result.returncode == 1
-        assert f"NOT intact: line {line_number}:" in result.stdout
+        verdict, detail = result.stdout.splitlines()[:2]
+        assert verdict == f"{target}: NOT intact" and detail.startswith(f"line {line_number}: ")
 
     missing = station("verify", str(tmp_path / "nope.jsonl"))
     assert missing.returncode == 2
@@ -114,3 +117,37 @@ def test_procedures_lists_builtins_and_site_overrides(tmp_path: Path, monkeypatc
     (site / "bad.toml").write_text("id = 'bad'\n")
     bad = station("procedures", "--procedures", str(site), cwd=tmp_path)
     assert bad.returncode == 1 and "bad.toml: missing required key 'title'" in bad.stdout
+
+
+def test_verify_fits_80_columns_with_the_hash_on_its_own_line(tmp_path: Path) -> None:
+    """Review finding 14: the verdict and the 64-digit hash used to share one 182-column line."""
+    path = make_session(tmp_path / "s")
+    result = station("verify", path.name, cwd=path.parent)
+    assert result.returncode == 0, result.stderr
+    assert all(len(line) <= 80 for line in result.stdout.splitlines()), result.stdout
+    assert result.stdout.splitlines()[-1].startswith("last hash: ")
+
+
+@pytest.mark.parametrize("command", ["verify", "export", "analyze"])
+@pytest.mark.parametrize("content", [b"cycle,x\n1,0.1\n", b"", b"hello", b'{"format":"other"}\n'])
+def test_a_file_that_is_not_a_session_is_named_so(
+    tmp_path: Path, command: str, content: bytes, capsys: pytest.CaptureFixture
+) -> None:
+    """Review finding 13: verify said "NOT intact: line 1: torn" (exit 1) on a CSV file."""
+    path = tmp_path / "readings.jsonl"
+    path.write_bytes(content)
+    args = [command, str(path)] + (["--csv"] if command == "export" else [])
+    assert main(args) == 2
+    what = "is empty:" if not content else "is"
+    assert capsys.readouterr().err == (
+        f"station: {path} {what} not a station session file (its first line is not a "
+        "station-session/1 header)\n"
+    )
+    assert path.read_bytes() == content
+
+
+def test_a_session_with_an_edited_format_is_damaged_not_foreign(tmp_path: Path) -> None:
+    path = make_session(tmp_path)
+    path.write_bytes(path.read_bytes().replace(b"station-session/1", b"station-session/2", 1))
+    result = station("verify", str(path))
+    assert result.returncode == 1 and result.stdout.splitlines()[1].startswith("line 1: ")

@@ -143,3 +143,43 @@ def test_hang_up_during_capture_leaves_a_resumable_session(tmp_path: Path) -> No
         assert "demo-robot" in screen
     finally:
         second.close()
+
+
+@pytest.mark.parametrize(
+    ("procedure", "count", "channels", "report"),
+    [
+        ("relative_accuracy", "2", ("x ", "y ", "z "), "RELATIVE ACCURACY"),
+        ("linearity", "3", ("h ", "v "), "LINEARITY"),
+    ],
+)
+def test_autopilot_demo_of_each_procedure_reaches_its_verdict(
+    tmp_path: Path, procedure: str, count: str, channels: tuple[str, ...], report: str
+) -> None:
+    """``station demo --procedure X --autopilot`` walks to the summary (a short run: 2 fixture
+    placements, 3 strokes along the bar) and shows the verdict words and the procedure's own
+    report block."""
+    command = ["demo", "--procedure", procedure, "--count", count, "--autopilot"]
+    pane = Pane(
+        _station(*command, "--pace", "0.05", "--sessions", str(tmp_path)),
+        tmp_path,
+    )
+    try:
+        pane.wait_for("Verdict:", timeout=120)
+        time.sleep(0.5)  # the summary paints in a few frames
+        screen = pane.wait_for("Export report", timeout=10)
+        assert report in screen, screen
+        lines = [line.strip() for line in screen.splitlines()]
+        verdict_lines = [line for line in lines if line[:2] in channels]
+        assert len(verdict_lines) == len(channels), screen
+        for line in verdict_lines:
+            assert "CAPABLE" in line or "UNDEFINED" in line, line
+        verdict = next(line for line in lines if line.startswith("Verdict:"))
+        assert verdict.split()[1] in ("CAPABLE", "NOT", "UNDEFINED"), verdict
+        sessions = list((tmp_path / "demo").glob("*.jsonl"))
+        assert len(sessions) == 1
+        verify = subprocess.run(
+            _station("verify", str(sessions[0])), capture_output=True, text=True, cwd=ROOT
+        )
+        assert verify.returncode == 0, verify.stdout + verify.stderr
+    finally:
+        pane.close()

@@ -320,3 +320,44 @@ def test_a_wheel_carries_the_builtin_procedures(tmp_path: Path) -> None:
     folder, ids = found.stdout.splitlines()
     assert Path(folder) == target / "station" / "builtin_procedures"
     assert "repeatability" in ids.split()
+
+
+# Review finding 17: the analysis a procedure's sessions get is declared, not guessed from its id.
+REPEAT = """
+[[steps]]
+id = "place"
+kind = "repeat"
+title = "Place"
+target = 3
+
+[[steps.steps]]
+id = "grab"
+kind = "capture"
+title = "Grab"
+"""
+STROKE = CHECK.replace('kind = "check"', 'kind = "stroke"\ndirection_channel = "z"')
+
+
+def test_the_analysis_kind_defaults_by_step_kinds(tmp_path: Path) -> None:
+    assert load_procedure(write(tmp_path, HEAD + CHECK)).analysis == "repeatability"
+    assert load_procedure(write(tmp_path, HEAD + REPEAT)).analysis == "relative_accuracy"
+    assert load_procedure(write(tmp_path, HEAD + STROKE)).analysis == "linearity"
+    builtin = discover_procedures(use_env=False)
+    assert {p.id: p.analysis for p in builtin.procedures} == {
+        "repeatability": "repeatability",
+        "relative_accuracy": "relative_accuracy",
+        "linearity": "linearity",
+    }
+
+
+def test_a_declared_analysis_kind_is_kept_and_validated(tmp_path: Path) -> None:
+    declared = HEAD.replace('unit = "in"', 'unit = "in"\nanalysis = "repeatability"')
+    assert load_procedure(write(tmp_path, declared + REPEAT)).analysis == "repeatability"
+    for kind, body, fault in (
+        ("accuracy", CHECK, "'analysis' must be one of repeatability, relative_accuracy, "),
+        ("linearity", CHECK, "'analysis' linearity needs a stroke step"),
+        ("relative_accuracy", CHECK, "'analysis' relative_accuracy needs a repeat block"),
+    ):
+        text = HEAD.replace('unit = "in"', f'unit = "in"\nanalysis = "{kind}"') + body
+        with pytest.raises(StationError, match=fault):
+            load_procedure(write(tmp_path, text))

@@ -16,29 +16,32 @@ import pytest
 
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import AxisModel, GaugeSpec, Simulator, fixture_model
+from station.runner import format_value
 from station.session.model import Session
 
 REPO = Path(__file__).resolve().parents[2]
 CYCLE_LINE = re.compile(r"^cycle (\d+) (.*)$")
 
 
-def make_simulator(seed: int) -> Simulator:
-    """A polled Mitutoyo fixture in inches; answers as fast as it is asked."""
+def make_simulator(seed: int, push_rate: float = 0.0) -> Simulator:
+    """A Mitutoyo fixture in inches: answers polls as fast as it is asked, and with
+    ``push_rate`` also sends that many sets a second by itself (a streaming push device)."""
     model = fixture_model(
         ("x", "y", "z"),
         axis=AxisModel(noise=0.0003),
         gauge=GaugeSpec(resolution=0.0001, unit="in", low=-1.0, high=1.0),
     )
-    return Simulator(get_protocol("mitutoyo"), model, seed=seed)
+    return Simulator(get_protocol("mitutoyo"), model, seed=seed, push_rate=push_rate)
 
 
 @pytest.fixture
-def simulators() -> Iterator[Callable[[int], Simulator]]:
-    """``simulators(seed)``: a started simulator on a pty, stopped after the test."""
+def simulators() -> Iterator[Callable[..., Simulator]]:
+    """``simulators(seed, push_rate=0.0)``: a started simulator on a pty, stopped after the
+    test."""
     started: list[Simulator] = []
 
-    def start(seed: int) -> Simulator:
-        sim = make_simulator(seed)
+    def start(seed: int, push_rate: float = 0.0) -> Simulator:
+        sim = make_simulator(seed, push_rate)
         sim.start_pty()
         started.append(sim)
         return sim
@@ -79,15 +82,17 @@ class Capture:
                 self._changed.notify_all()
         stream.close()
 
-    def wait_line(self, predicate: Callable[[str], bool], timeout: float) -> bool:
-        """Wait until a stdout line satisfies ``predicate`` (False on timeout or exit)."""
+    def wait_line(
+        self, predicate: Callable[[str], bool], timeout: float, *, stderr: bool = False
+    ) -> bool:
+        """Wait until a stdout (``stderr``: stderr) line satisfies ``predicate`` (False on
+        timeout or exit)."""
         deadline = time.monotonic() + timeout
+        lines, pump = (self.errors, self._threads[1]) if stderr else (self.lines, self._threads[0])
         with self._changed:
-            while not any(predicate(line) for line in self.lines):
+            while not any(predicate(line) for line in lines):
                 remaining = deadline - time.monotonic()
-                if remaining <= 0 or (
-                    self.process.poll() is not None and not self._threads[0].is_alive()
-                ):
+                if remaining <= 0 or (self.process.poll() is not None and not pump.is_alive()):
                     return False
                 self._changed.wait(min(remaining, 0.05))
             return True
@@ -117,7 +122,9 @@ class Capture:
         return None
 
 
-def capture_args(url: str, sessions: Path, cycles: int) -> list[str]:
+def capture_args(
+    url: str, sessions: Path, cycles: int, *, timeout: float = 3, trigger: str = "poll"
+) -> list[str]:
     """A new repeatability session on the simulator at ``url``."""
     return [
         "--procedure",
@@ -135,14 +142,21 @@ def capture_args(url: str, sessions: Path, cycles: int) -> list[str]:
         "--cycles",
         str(cycles),
         "--timeout",
-        "3",
+        f"{timeout:g}",
+        "--trigger",
+        trigger,
     ]
 
 
 def values_text(session: Session, cycle: int) -> str:
-    """A recorded cycle's values as ``station capture`` prints them."""
+    """A recorded cycle's values as ``station capture`` prints them: at the decimals of the
+    session's gauge resolution."""
     readings = session.cycles[cycle].readings
-    return " ".join(f"{channel}={reading.value:+.5f}" for channel, reading in readings.items())
+    resolution = session.header["resolution"]
+    return " ".join(
+        f"{channel}={format_value(reading.value, resolution)}"
+        for channel, reading in readings.items()
+    )
 
 
 def assert_acknowledged_kept(capture: Capture, session: Session) -> None:

@@ -85,3 +85,13 @@ def test_full_disk_stops_with_one_line(simulators, small_tmpfs, tmp_path):
     resumed = Capture(["--resume", str(roomy), "--timeout", "3"])
     assert resumed.finish(60) == 0, resumed.errors
     assert load_session(roomy).status == "finished"
+
+
+def test_push_trigger_failed_write_says_why(simulators, tmp_path):
+    """With the push trigger the sets are written on the runner's own thread: the failed
+    write's sentence (not a bare "the session is failed") still ends the command."""
+    url = simulators(23, push_rate=40.0).url
+    args = capture_args(url, tmp_path, CYCLES, trigger="push")
+    capture = Capture(args, preexec_fn=limit_file_size)
+    path = assert_stopped_cleanly(capture, "file-size limit")
+    assert load_session(path).status == "running"  # no word could be written after the failure

@@ -4,6 +4,7 @@ nothing acknowledged lost, and ``--resume`` continues the numbering."""
 from __future__ import annotations
 
 import signal
+import threading
 
 import pytest
 
@@ -13,15 +14,34 @@ from station.session.verify import verify_session
 from .conftest import Capture, assert_acknowledged_kept, capture_args
 
 CYCLES = 60
+HELD_AFTER = 10
+"""The simulator stops answering after this many readings of z (the unit check's, the zero's
+and a few cycles'): the capture cannot run out of cycles before the signal, however slow the
+machine."""
 
 
 @pytest.mark.parametrize("signum", [signal.SIGHUP, signal.SIGTERM], ids=["SIGHUP", "SIGTERM"])
 def test_signal_mid_capture_is_clean_and_resumable(simulators, tmp_path, signum):
-    url = simulators(int(signum)).url
-    capture = Capture(capture_args(url, tmp_path, CYCLES))
-    assert capture.wait_line(lambda line: line.startswith("cycle 5 "), 30.0), capture.errors
-    capture.process.send_signal(signum)
-    assert capture.finish() == 128 + signum
+    simulator = simulators(int(signum))
+    url = simulator.url
+    answering = threading.Event()
+
+    def hold(channel: str, k: int) -> None:
+        # Runs on the simulator's thread: blocking it is the gauges falling silent.
+        if channel == "z" and k + 1 >= HELD_AFTER:
+            answering.wait(120)
+
+    simulator.on_sent = hold
+    # A long timeout: held gauges must not end the run (3 refused sets) before the signal.
+    capture = Capture(capture_args(url, tmp_path, CYCLES, timeout=30))
+    try:
+        assert capture.wait_line(lambda line: line.startswith("cycle 5 "), 60.0), capture.errors
+        capture.process.send_signal(signum)
+        assert capture.finish() == 128 + signum
+    finally:
+        simulator.on_sent = None
+        answering.set()
+    assert max(capture.acknowledged) < CYCLES  # the signal came mid-capture
     name = signal.Signals(signum).name
     assert f"station: {name}: session interrupted" in capture.errors[-1]
     assert "--resume" in capture.errors[-1]

@@ -9,9 +9,26 @@ from pathlib import Path
 import pytest
 
 from station.procedures import discover_procedures
-from station.session.journal import SessionWriter, session_header
+from station.runner import PortSetup, SessionSetup
+from station.session.journal import SessionWriter
 
 CHANNELS = ("x", "y", "z")
+
+
+def session_header_fields(
+    procedure_id: str = "repeatability", *, robot: str = "r2", operator: str = "ana", **setup
+) -> dict:
+    """The header fields production writes: ``SessionSetup(...).header_fields()``, the one
+    function the TUI and ``station capture`` use (review finding 16)."""
+    procedure = discover_procedures(use_env=False).get(procedure_id)
+    port = PortSetup(
+        url="loop://",
+        protocol="mitutoyo",
+        channel_map={str(n): ch for n, ch in enumerate(procedure.channels, start=1)},
+    )
+    return SessionSetup(
+        procedure=procedure, robot=robot, operator=operator, ports=(port,), **setup
+    ).header_fields()
 
 
 def reading_fields(cycle: int) -> dict:
@@ -33,8 +50,7 @@ def reading_fields(cycle: int) -> dict:
 
 def write_session(folder: Path, cycles: int = 5, *, finish: bool = True, robot: str = "r2") -> Path:
     """A session with one of every common event type; returns its path (writer closed)."""
-    procedure = discover_procedures(use_env=False).get("repeatability")
-    header = session_header(procedure, robot=robot, operator="ana", instruments={"port": "sim"})
+    header = session_header_fields(robot=robot, operator="ana")
     moment = datetime(2026, 11, 23, 12, 0, 0, tzinfo=UTC)
     with SessionWriter.create(folder, header, now=moment) as writer:
         writer.append("instrument", action="connect", port="sim")

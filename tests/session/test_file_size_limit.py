@@ -43,11 +43,12 @@ CHILD = textwrap.dedent(
 HELPER = textwrap.dedent(
     """
     from station.procedures import discover_procedures
-    from station.session.journal import session_header
+    from station.runner import PortSetup, SessionSetup
 
     def header():
         procedure = discover_procedures(use_env=False).get("repeatability")
-        return session_header(procedure, robot="r2", operator="ana")
+        port = PortSetup("loop://", "mitutoyo", {"1": "x", "2": "y", "3": "z"})
+        return SessionSetup(procedure, "r2", "ana", (port,)).header_fields()
 
     def reading(cycle):
         return {

@@ -60,9 +60,10 @@ class ChecklistScreen(Screen[None]):
             with Vertical(id="step-panel"):
                 yield Static(id="step-title")
                 yield Static(id="step-text")
-                yield Vertical(id="step-inputs")
+                # What Enter does and why a value was refused stay in view above the fields.
                 yield Static(id="step-action")
                 yield Static(id="step-message")
+                yield Vertical(id="step-inputs")
         yield Footer()
 
     def on_mount(self) -> None:
@@ -79,13 +80,13 @@ class ChecklistScreen(Screen[None]):
         key = (current.index, current.id) if current is not None else None
         if key != self._shown_step:
             self._shown_step = key
-            self._show_step(current)
+            self._show_step(current, state.placements)
         message = state.messages[-1] if state.messages else None
         if message is not None:
             style = {"error": "bold red", "warning": "yellow"}.get(message.level, "green")
             self.query_one("#step-message", Static).update(Text(message.text, style=style))
 
-    def _show_step(self, view: StepView | None) -> None:
+    def _show_step(self, view: StepView | None, placements: int | None = None) -> None:
         inputs = self.query_one("#step-inputs", Vertical)
         inputs.remove_children()
         if view is None:
@@ -94,13 +95,23 @@ class ChecklistScreen(Screen[None]):
             self.query_one("#step-action", Static).update("")
             return
         step = view.step
-        placement = f" (placement {view.placement})" if view.placement else ""
+        placement = ""
+        if view.placement:
+            of = f" of {placements}" if placements else ""
+            placement = f" (placement {view.placement}{of})"
         self.query_one("#step-title", Static).update(
             Text(f"Step {view.index + 1}: {step.title}{placement}", style="bold")
         )
-        self.query_one("#step-text", Static).update(" ".join(step.text.split()))
+        text = Text(" ".join(step.text.split()))
+        pendant = self._demo_pendant(view) if step.kind == "input" else None
+        if pendant is not None:
+            text.append("\n\nTeach pendant (simulated): ", style="bold")
+            text.append(pendant, style="bold reverse")
+        self.query_one("#step-text", Static).update(text)
         action = ENTER_DOES.get(step.kind, "Press Enter to continue.")
-        if self.app.config.demo is not None:
+        if self.app.config.demo is not None and step.kind == "input":
+            action += " (Demo: copy the simulated pendant's X, Y, Z shown above.)"
+        elif self.app.config.demo is not None:
             action += " (Demo: the robot and the gauges are simulated; just press Enter.)"
         self.query_one("#step-action", Static).update(Text(action, style="bold cyan"))
         if step.kind == "input":
@@ -117,6 +128,15 @@ class ChecklistScreen(Screen[None]):
                 )
                 inputs.mount(row)
             self.call_after_refresh(self._focus_first_input)
+
+    def _demo_pendant(self, view: StepView) -> str | None:
+        """What the demo's simulated pendant shows at this placement (None off the demo)."""
+        fixture = self.app.demo_fixture
+        placement = fixture.pendant(view.placement) if fixture is not None else None
+        if placement is None:
+            return None
+        unit = str(self.app.session_header.get("unit") or "in")
+        return str(placement.pendant_text(unit))
 
     def _focus_first_input(self) -> None:
         for widget in self.query("#step-inputs Input"):

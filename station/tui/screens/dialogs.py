@@ -93,6 +93,9 @@ HELP_TEXT = """\
   n note · p pause / continue · f finish · x y z or Tab choose the axis in the charts
   q leave (the session stays resumable)
 
+[b]Strokes[/b]  (linearity) the strokes stream as the robot shuttles A↔B · e end the stroke
+  now (streaming stops; Space streams again) · f finish · h v or Tab choose the indicator
+
 [b]Summary[/b]  e export the text report · c export CSV · d charts · h home · q quit
 
 Every reading is on disk (fsynced) before it is shown as captured. If the link drops, the

@@ -86,6 +86,13 @@ class HomeScreen(Screen[None]):
         choices.add_option(
             Option("New session (choose the procedure, robot, limits and port)", id="new")
         )
+        if config.demo_lab is not None:
+            from station.tui.instruments import DEMO_PROCEDURES
+
+            for procedure, setup in DEMO_PROCEDURES.items():
+                if procedure != config.demo.procedure:  # type: ignore[union-attr]
+                    label = f"Demo {procedure.replace('_', ' ')} instead ({setup})"
+                    choices.add_option(Option(label, id=f"demo:{procedure}"))
         choices.add_option(Option(f"Review saved sessions ({self._session_count})", id="review"))
         choices.add_option(Option("Quit", id="quit"))
         choices.highlighted = 0
@@ -103,6 +110,8 @@ class HomeScreen(Screen[None]):
             self.open_resume(self._unfinished[int(choice.split(":", 1)[1])])
         elif choice == "new":
             self.action_new()
+        elif choice.startswith("demo:"):
+            self.open_new(choice.split(":", 1)[1])
         elif choice == "review":
             self.action_review()
         elif choice == "quit":

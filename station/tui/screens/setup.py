@@ -149,7 +149,6 @@ class SetupScreen(Screen[None]):
         from station.instruments.transport import list_ports
 
         catalog = self.app.catalog
-        demo = self.app.config.demo
         if self.resume_path is not None:
             self._header = _read_header(self.resume_path)
             self.procedure_id = self._header.get("procedure", {}).get("id", self.procedure_id)
@@ -158,6 +157,9 @@ class SetupScreen(Screen[None]):
             self.procedure_id = "repeatability" if "repeatability" in ids else ids[0]
         procedure = catalog.get(self.procedure_id)
         self.procedure_id = procedure.id
+        # In the demo each procedure has its own simulated set-up (and port).
+        demo = self.app.demo_port(procedure.id)
+        count = count_field(procedure)
         header = self._header
         recorded_port = (header.get("instruments", {}).get("ports") or [{}])[0]
         resuming = self.resume_path is not None
@@ -228,7 +230,7 @@ class SetupScreen(Screen[None]):
                 "the gauge's smallest step, in the unit above",
             )
             recorded_limits = header.get("limits") or {}
-            for channel in procedure.channels:
+            for channel in judged_channels(procedure):
                 limit = recorded_limits.get(channel) or procedure.limits.get(channel)
                 value = DEMO_LIMITS if demo is not None and limit is None else ""
                 if isinstance(limit, dict):
@@ -248,15 +250,19 @@ class SetupScreen(Screen[None]):
                 )
             yield Static(LIMIT_HELP, classes="field-hint")
             yield from _field(
-                "Cycles",
+                count.label,
                 Input(
                     compact=True,
-                    value=str(header.get("cycles_target") or procedure.cycles_target),
+                    value=str(
+                        header.get(count.header_key)
+                        or (demo.count if demo else None)
+                        or count.target
+                    ),
                     id="cycles",
                     disabled=resuming,
                 ),
                 "cycles",
-                f"the report asks for {procedure.cycles_min} to {procedure.cycles_target}",
+                count.hint,
             )
             detected = [(f"{p.device}  {p.description}", p.device) for p in list_ports()]
             port_value = recorded_port.get("url") or (demo.url if demo else "")
@@ -301,7 +307,9 @@ class SetupScreen(Screen[None]):
                 "map",
                 "device channel = axis, e.g. 1=x,2=y,3=z",
             )
-            trigger = header.get("instruments", {}).get("trigger", "poll")
+            trigger = header.get("instruments", {}).get("trigger") or (
+                demo.trigger if demo else "poll"
+            )
             yield from _field(
                 "Trigger",
                 self._select("trigger", TRIGGER_CHOICES, trigger, disabled=resuming),
@@ -353,7 +361,11 @@ class SetupScreen(Screen[None]):
             and event.value not in (Select.NULL, self.procedure_id)
             and self.resume_path is None
         ):
-            kept = {key: self._value(key) for key in KEPT_ON_PROCEDURE_CHANGE}
+            # The demo's line belongs to the procedure's own simulator: not kept.
+            keys = (
+                KEPT_ON_PROCEDURE_CHANGE[:2] if self.app.config.demo else KEPT_ON_PROCEDURE_CHANGE
+            )
+            kept = {key: self._value(key) for key in keys}
             self.app.switch_screen(SetupScreen(procedure_id=str(event.value), typed=kept))
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
@@ -468,7 +480,7 @@ class SetupScreen(Screen[None]):
                 f"The resolution must be a positive number such as {procedure.resolution:g}."
             )
         limits: dict[str, Any] = {}
-        for channel in procedure.channels:
+        for channel in judged_channels(procedure):
             try:
                 typed = parse_limits_text(self._value(f"limits-{channel}"))
                 if typed is None:
@@ -478,16 +490,14 @@ class SetupScreen(Screen[None]):
                 limits[channel] = SpecLimits(lsl=typed.lsl, usl=typed.usl, nominal=typed.nominal)
             except StationError as error:
                 errors[f"limits-{channel}"] = error.message
+        count = count_field(procedure)
         cycles: int | None = None
         try:
             cycles = int(self._value("cycles"))
-            if cycles < procedure.cycles_min:
-                errors["cycles"] = (
-                    f"The report asks for at least {procedure.cycles_min} cycles; "
-                    f"give {procedure.cycles_min} to {procedure.cycles_target}."
-                )
+            if cycles < count.minimum:
+                errors["cycles"] = count.too_few
         except ValueError:
-            errors["cycles"] = f"Give a whole number of cycles, e.g. {procedure.cycles_target}."
+            errors["cycles"] = f"Give a whole number of {count.noun}, e.g. {count.target}."
         ports = self.read_ports(errors)
         if errors:
             self._refuse(errors)
@@ -502,7 +512,7 @@ class SetupScreen(Screen[None]):
                 unit=self._value("unit"),
                 resolution=resolution,
                 limits=limits,
-                cycles=cycles,
+                **{count.setup_key: cycles},
             )
         except StationError as error:
             self._say("setup", error.message)
@@ -575,6 +585,74 @@ class SetupScreen(Screen[None]):
         self.call_after_refresh(self._show_buttons)
         if message.done:
             self._testing = False
+
+
+@dataclass(frozen=True)
+class CountField:
+    """What the set-up's count field asks for: cycles (repeatability), placements (a
+    ``repeat`` block, relative accuracy) or strokes (a ``stroke`` step, linearity)."""
+
+    label: str
+    noun: str
+    setup_key: str
+    """The ``SessionSetup`` argument it fills: ``cycles``, ``placements`` or ``strokes``."""
+    header_key: str
+    target: int
+    minimum: int
+    hint: str
+    too_few: str
+
+
+def count_field(procedure: Procedure) -> CountField:
+    """The count field of ``procedure``'s set-up (see :class:`CountField`)."""
+    steps = list(procedure.steps)
+    stroke = next((s for s in steps if s.kind == "stroke"), None)
+    repeat = next((s for s in steps if s.kind == "repeat"), None)
+    if stroke is not None:
+        target = int(stroke.count_target or procedure.cycles_target)
+        low = int(stroke.count_min or target)
+        # Fewer strokes are allowed (a short trial run); the report's range is said.
+        return CountField(
+            "Strokes",
+            "strokes",
+            "strokes",
+            "strokes_target",
+            target,
+            2,
+            f"A↔B strokes; the report asks for {low} to {target}",
+            f"Give at least 2 strokes (one each way); the report asks for {low} to {target}.",
+        )
+    if repeat is not None:
+        target = int(repeat.count_target or 1)
+        low = int(repeat.count_min or target)
+        return CountField(
+            "Placements",
+            "placements",
+            "placements",
+            "placements_target",
+            target,
+            1,
+            f"fixture placements over the envelope; the report asks for a few ({low} to {target})",
+            "Give at least 1 fixture placement.",
+        )
+    return CountField(
+        "Cycles",
+        "cycles",
+        "cycles",
+        "cycles_target",
+        procedure.cycles_target,
+        procedure.cycles_min,
+        f"the report asks for {procedure.cycles_min} to {procedure.cycles_target}",
+        f"The report asks for at least {procedure.cycles_min} cycles; "
+        f"give {procedure.cycles_min} to {procedure.cycles_target}.",
+    )
+
+
+def judged_channels(procedure: Procedure) -> list[str]:
+    """The channels that take limits: all but a stroke step's position channel (the linear
+    scale measures where along the bar, not an error)."""
+    positions = {s.direction_channel for s in procedure.steps if s.kind == "stroke"}
+    return [c for c in procedure.channels if c not in positions]
 
 
 def _login_name() -> str:

@@ -48,18 +48,24 @@ class SummaryView:
     cycle_numbers: tuple[int, ...] = ()
     excluded_cycles: tuple[int, ...] = ()
     notes: tuple[str, ...] = field(default_factory=tuple)
+    report: Any = None
+    """A linearity or relative-accuracy session's own analysis (``ProcedureReport``): its
+    ``analysis`` is then what the verdict judges."""
 
     @classmethod
     def from_live(cls, state: RunnerState, analysis: Any, header: Mapping[str, Any]) -> SummaryView:
         """After ``finish``: the runner's final state and analysis."""
+        report, notes = _procedure_report(state.path, header)
         return cls(
             path=state.path,
             header=dict(header),
-            analysis=analysis,
+            analysis=report.analysis if report is not None else analysis,
             last_hash=state.last_hash,
             status=state.status,
             cycle_numbers=tuple(r.cycle for r in state.cycles if r.rejected is None),
             excluded_cycles=tuple(r.cycle for r in state.cycles if r.rejected is not None),
+            notes=notes,
+            report=report,
         )
 
     @classmethod
@@ -69,8 +75,10 @@ class SummaryView:
         from station.tui.review_analysis import analyze_session
 
         session = load_session(path, recover=False)
-        analysis = analyze_session(session)
-        notes = (session.torn.message,) if session.torn is not None else ()
+        report, notes = _procedure_report(path, session.header)
+        analysis = report.analysis if report is not None else analyze_session(session)
+        if session.torn is not None:
+            notes = (*notes, session.torn.message)
         return cls(
             path=path,
             header=dict(session.header),
@@ -80,6 +88,7 @@ class SummaryView:
             cycle_numbers=session.accepted_cycles,
             excluded_cycles=session.excluded_cycles,
             notes=notes,
+            report=report,
         )
 
     @property
@@ -92,6 +101,35 @@ class SummaryView:
         """Decimals to show, from the gauge resolution."""
         resolution = self.header.get("resolution")
         return decimals_for(float(resolution) if resolution else None)
+
+
+REPORT_WIDTH = 74
+"""The procedure's report block fits the summary's column at 80×24 (scrollbar and padding)."""
+
+
+def _procedure_report(path: Path, header: Mapping[str, Any]) -> tuple[Any, tuple[str, ...]]:
+    """A linearity or relative-accuracy session's own analysis (None for repeatability), and
+    a note saying why there is none when its file has nothing to analyse yet."""
+    from station.tui.review_analysis import PROCEDURE_REPORTS, procedure_report
+
+    procedure = header.get("procedure")
+    recorded = procedure if isinstance(procedure, Mapping) else {"id": procedure}
+    # The analysis the procedure declares (a site's own accuracy procedure has its own id).
+    kind = recorded.get("analysis") or recorded.get("id")
+    if kind not in PROCEDURE_REPORTS and "analysis" in recorded:
+        return None, ()
+    try:
+        return procedure_report(path, REPORT_WIDTH), ()
+    except StationError as error:
+        return None, (error.message,)
+
+
+def report_text(view: SummaryView) -> Text:
+    """The procedure's own report block (straightness per stroke and path repeatability, or
+    accuracy per placement and across placements), as ``station analyze FILE`` prints it."""
+    if view.report is None:
+        return Text("")
+    return Text("\n".join(view.report.lines), no_wrap=True, overflow="crop")
 
 
 def verdict_text(view: SummaryView) -> Text:
@@ -207,12 +245,20 @@ class SummaryScreen(Screen[None]):
         title = Text("Summary", style="bold")
         title.append(
             f"  robot {header.get('robot', '?')} · {procedure.get('id', '')} · operator "
-            f"{header.get('operator') or 'not given'} · {len(self.view.cycle_numbers)} cycles",
+            f"{header.get('operator') or 'not given'} · "
+            + (
+                self.view.report.count
+                if self.view.report is not None
+                else f"{len(self.view.cycle_numbers)} cycles"
+            ),
         )
         yield Static(title, id="summary-title")
         with VerticalScroll(id="summary-body"):
             yield Static(_trimmed(verdict_text(self.view)), id="summary-verdict")
             yield Static(_trimmed(spatial_text(self.view)), id="summary-spatial")
+            report = Static(report_text(self.view), id="summary-report")
+            report.display = self.view.report is not None
+            yield report
             yield Static(hints_text(self.view), id="summary-hints")
             yield Static(file_text(self.view, self.exported), id="summary-file")
         yield Footer()
@@ -237,10 +283,14 @@ class SummaryScreen(Screen[None]):
             f"Last line hash (anchors the session file): {self.view.last_hash}",
             *self.view.notes,
         )
+        own = self.view.report
         report = format_report(
             self.view.analysis,
-            title=f"BASIC STATISTICS COMPREHENSIVE REPORT ON {self.view.path.name}",
+            title=own.title
+            if own is not None
+            else f"BASIC STATISTICS COMPREHENSIVE REPORT ON {self.view.path.name}",
             notes=notes,
+            sections=[list(own.lines)] if own is not None else [],
         )
         self._write(target, report, "report")
 

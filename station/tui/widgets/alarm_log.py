@@ -10,12 +10,13 @@ from textual.widgets import Static
 
 
 def alarm_lines(
-    analyses: Mapping[str, Any], cycle_numbers: Sequence[int] | None = None
+    analyses: Mapping[str, Any], cycle_numbers: Sequence[int] | None = None, label: str = "cycle"
 ) -> list[str]:
     """One sentence per alarm: ``cycle 17 x [report-1] <the rule's sentence>``.
 
     An alarm's points are 1-based positions among the accepted cycles; ``cycle_numbers`` maps
     them to cycle numbers, so the log names the cycle the operator saw even after a reject.
+    ``label`` names the points (``stroke`` for the straightness chart of a linearity run).
     """
     lines: list[tuple[int, str]] = []
     for channel, analysis in analyses.items():
@@ -28,7 +29,7 @@ def alarm_lines(
                 cycle = last
             rule = getattr(alarm, "rule", "?")
             text = getattr(alarm, "text", "")
-            lines.append((cycle, f"cycle {cycle} {channel} [{rule}] {text}"))
+            lines.append((cycle, f"{label} {cycle} {channel} [{rule}] {text}"))
     lines.sort(key=lambda item: item[0])
     return [line for _, line in lines]
 

@@ -33,6 +33,8 @@ class ChartData:
     decimals: int = 5
     title: str = ""
     message: str = ""
+    label: str = "cycle"
+    """What a point is (``cycle``, ``stroke``), written under the first one."""
 
 
 def _finite(value: Any) -> float | None:
@@ -42,8 +44,11 @@ def _finite(value: Any) -> float | None:
     return value if math.isfinite(value) else None
 
 
-def chart_data(channel: Any, cycle_numbers: list[int] | None, decimals: int) -> ChartData | None:
-    """The drawable part of a channel analysis (``.chart`` and ``.alarms``), or None."""
+def chart_data(
+    channel: Any, cycle_numbers: list[int] | None, decimals: int, label: str = "cycle"
+) -> ChartData | None:
+    """The drawable part of a channel analysis (``.chart`` and ``.alarms``), or None;
+    ``label`` names the points (``stroke`` for a linearity run's straightness chart)."""
     chart = getattr(channel, "chart", None)
     if chart is None:
         return None
@@ -65,6 +70,7 @@ def chart_data(channel: Any, cycle_numbers: list[int] | None, decimals: int) -> 
         decimals=decimals,
         title=f"{getattr(chart, 'type', 'control')} chart {getattr(channel, 'name', '')}".strip(),
         message=str(getattr(chart, "message", "") or ""),
+        label=label,
     )
 
 
@@ -115,15 +121,17 @@ def render_chart(data: ChartData | None, width: int, height: int) -> Text:
         for char, style in grid[row]:
             line.append(char, style=style)
         out.append(line)
-    out.append(_cycle_axis(data.labels[first:], spacing, plot_width))
+    out.append(_cycle_axis(data.labels[first:], spacing, plot_width, data.label))
     return Text("\n").join(out)
 
 
-def _cycle_axis(labels: tuple[int, ...], spacing: int, plot_width: int) -> Text:
+def _cycle_axis(
+    labels: tuple[int, ...], spacing: int, plot_width: int, label: str = "cycle"
+) -> Text:
     """``cycle 1`` under the first point and the last cycle's number under the last."""
     cells = [" "] * (plot_width + _GUTTER)
     if labels:
-        head = f"cycle {labels[0]}"
+        head = f"{label} {labels[0]}"
         cells[_GUTTER : _GUTTER + len(head)] = head
         tail = str(labels[-1])
         end = _GUTTER + (len(labels) - 1) * spacing + 1

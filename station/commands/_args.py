@@ -1,0 +1,52 @@
+"""Numbers from the command line, read the same way by every command.
+
+Commands take numeric options as text and parse them here, so that a bad value is the same
+one-line ``station: ...`` error as every other bad input (not argparse's usage block), worded
+the same whichever command it came to.
+"""
+
+from __future__ import annotations
+
+import math
+
+from station.errors import StationError
+
+
+def parse_number(text: str | None, option: str) -> float | None:
+    """A finite number given as ``option``; None when absent or blank."""
+    if text is None or not text.strip():
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise StationError(f"{option} {text!r} is not a number.") from None
+    if not math.isfinite(value):
+        raise StationError(f"{option} {text!r} is not a finite number.")
+    return value
+
+
+def positive_number(text: str | None, option: str, kind: type = float) -> float | int | None:
+    """A number above 0 given as ``option`` (a whole one with ``kind=int``); None when absent."""
+    if text is None:
+        return None
+    if kind is int:
+        try:
+            value: float | int = int(text)
+        except ValueError:
+            word = "a whole number" if _is_float(text) else "a number"
+            raise StationError(f"{option} {text!r} is not {word}.") from None
+    else:
+        value = parse_number(text, option) if text.strip() else None
+        if value is None:
+            raise StationError(f"{option} {text!r} is not a number.")
+    if not value > 0:
+        raise StationError(f"{option} must be more than 0, not {text}.")
+    return value
+
+
+def _is_float(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True

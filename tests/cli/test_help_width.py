@@ -1,0 +1,23 @@
+"""Review finding 14: every help text of these commands reads on an 80-column terminal."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+
+@pytest.mark.parametrize("command", ["simulate", "analyze", "read", "verify", "export"])
+def test_help_fits_80_columns(command: str) -> None:
+    result = subprocess.run(
+        [sys.executable, "-m", "station", command, "--help"],
+        capture_output=True,
+        text=True,
+        timeout=30,
+        env={**os.environ, "COLUMNS": "80"},
+    )
+    assert result.returncode == 0, result.stderr
+    wide = [line for line in result.stdout.splitlines() if len(line) > 79]
+    assert wide == [], "\n".join(wide)

@@ -1,0 +1,11 @@
+"""Settings for the whole suite."""
+
+import signal
+
+# A shell that starts the suite as a background job (`pytest &`, some CI runners) sets SIGINT
+# to "ignored", and every subprocess a test starts would inherit that: the tests that press
+# Ctrl-C on `station read` or `station simulate` would then wait forever. Python's own handler
+# here makes the children start with the default action again (a caught signal is reset on
+# exec; an ignored one is not).
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
