@@ -139,169 +139,64 @@ def is_session_file(path: Path) -> bool:
     return looks_like_session(first)
 
 
-@dataclass
-class Source:
-    """What a file gives the analysis: channels, and for a session its recorded settings."""
-
-    channels: dict[str, Any]
-    cycles: dict[str, Any] | None = None  # the cycle number of each reading, per channel
-    excluded_cycles: tuple[int, ...] = ()
-    config: AnalysisConfig | None = None  # a session's recorded limits, resolution, unit, rules
-    notes: tuple[str, ...] = ()
-    analysis: str | None = None  # a session's analysis kind (see session_analysis)
-    session: Any = None  # the replayed session (station.session.model.Session)
-    table: Any = None  # the CSV table (station.session.tables.ReadingTable)
-
-
-def load_session_source(path: Path) -> Source:
-    """Channels of a session file (rejected cycles left out) and its recorded settings."""
-    from station.runner import analysis_config
-    from station.session.model import load_session
-
-    session = load_session(path, recover=False)
-    notes = [
-        f"Session {session.session_id}: robot {session.robot}, operator "
-        f"{session.operator or 'not given'}, procedure {session.procedure_id}, "
-        f"created {session.created}, {session.status}.",
-        f"Last line hash (anchors the session file): {session.last_hash}",
-    ]
-    if session.torn is not None:
-        notes.append(f"Torn tail: {session.torn.message}")
-    channels = {name: values for name, values in session.channel_values().items() if len(values)}
-    cycles = session.channel_cycles()
-    return Source(
-        channels=channels,
-        cycles={name: cycles[name] for name in channels},
-        excluded_cycles=tuple(session.excluded_cycles),
-        # The same settings the live analysis of the running session used.
-        config=analysis_config(session.header),
-        notes=tuple(notes),
-        analysis=session_analysis(session),
-        session=session,
-    )
-
-
-def session_analysis(session: Any) -> str:
-    """How to analyse a session: the analysis its header records for its procedure; else that
-    of the same procedure file (id and sha256) where this machine has it; else what the
-    session holds, as a procedure's default follows its steps (streamed strokes: linearity;
-    captures at fixture placements: relative accuracy; otherwise repeatability)."""
-    from station.procedures import discover_procedures
-
-    recorded = session.header["procedure"]
-    if recorded.get("analysis") in ANALYSIS_KINDS:
-        return str(recorded["analysis"])
-    try:
-        catalog = discover_procedures()
-        procedure = next(
-            (
-                p
-                for p in catalog.procedures
-                if p.id == recorded.get("id") and p.sha256 == recorded.get("sha256")
-            ),
-            None,
-        )
-    except StationError:  # a STATION_PROCEDURES folder that is gone: judge by the content
-        procedure = None
-    if procedure is not None:
-        return procedure.analysis
-    if session.samples:
-        return "linearity"
-    if any(cycle.placement is not None for cycle in session.cycles.values()):
-        return "relative_accuracy"
-    return "repeatability"
-
-
-def load_source(path: Path) -> Source:
-    """A session file (detected by its header) or a CSV table of readings."""
+def load_source(path: Path) -> Any:
+    """A session file (detected by its header: a ``SessionSource``) or a CSV table of readings
+    (a ``TableSource``)."""
     if path.is_file() and is_session_file(path):
+        from station.session.report import load_session_source
+
         return load_session_source(path)
     from station.session.tables import read_table
 
     table = read_table(path)
     cycles = None if table.cycles is None else dict.fromkeys(table.channels, table.cycles)
-    return Source(channels=table.channels, cycles=cycles, table=table)
+    return TableSource(channels=table.channels, cycles=cycles, table=table)
 
 
-def linearity_profiles(source: Source, path: Path) -> list[Any]:
-    """The strokes of a linearity CSV (columns stroke, s, h, v) or session (samples events)."""
-    import numpy as np
+@dataclass(frozen=True)
+class TableSource:
+    """What a CSV table gives the analysis (the attributes a ``SessionSource`` also has)."""
 
-    from station.analysis.linearity import profiles_from_stream, profiles_from_table
-
-    if source.table is not None:
-        from station.session.tables import require_columns
-
-        columns = require_columns(source.table, LINEARITY_COLUMNS, "a linearity table")
-        return profiles_from_table(
-            columns["stroke"], columns["s"], {"h": columns["h"], "v": columns["v"]}
-        )
-    batches = [b for b in source.session.samples if {"s", "h", "v"} <= set(b.channels)]
-    # A runner marks the last event of each whole stroke (`end`); a lead-in or a stroke cut
-    # short by an interruption has no mark and is left out. Files without marks: every stroke.
-    ended = {event["seq"] for event in source.session.events if event.get("end")}
-    if ended:
-        whole = {b.stroke for b in batches if b.seq in ended}
-        batches = [b for b in batches if b.stroke in whole]
-    if not batches:
-        raise StationError(
-            f"{path}: the session has no streamed strokes (samples events with h, v and s) "
-            "to analyse yet."
-        )
-    arrays = [b.as_arrays() for b in batches]
-    joined = {c: np.concatenate([a[c] for a in arrays]) for c in ("s", "h", "v")}
-    if all(b.stroke is not None for b in batches):
-        numbers = np.concatenate(
-            [np.full(len(a["s"]), b.stroke) for a, b in zip(arrays, batches, strict=True)]
-        )
-        return profiles_from_table(numbers, joined["s"], {"h": joined["h"], "v": joined["v"]})
-    # Batches without stroke numbers are one stream: split it by the scale's travel.
-    return profiles_from_stream(joined["s"], {"h": joined["h"], "v": joined["v"]})
+    channels: dict[str, Any]
+    cycles: dict[str, Any] | None
+    table: Any  # station.session.tables.ReadingTable
+    excluded_cycles: tuple[int, ...] = ()
+    config: AnalysisConfig | None = None
+    notes: tuple[str, ...] = ()
+    analysis: str | None = None
 
 
-def accuracy_inputs(source: Source) -> tuple[Any, dict[str, Any], dict[int, tuple[float, ...]]]:
-    """Placements, errors x, y, z and pendant coordinates of an accuracy CSV or session."""
-    import numpy as np
+def table_linearity_profiles(table: Any) -> list[Any]:
+    """The strokes of a linearity CSV (columns stroke, s, h, v)."""
+    from station.analysis.linearity import profiles_from_table
+    from station.session.tables import require_columns
 
-    if source.table is not None:
-        from station.session.tables import require_columns
+    columns = require_columns(table, LINEARITY_COLUMNS, "a linearity table")
+    return profiles_from_table(
+        columns["stroke"], columns["s"], {"h": columns["h"], "v": columns["v"]}
+    )
 
-        columns = require_columns(source.table, ACCURACY_COLUMNS, "a relative-accuracy table")
-        pendant: dict[int, tuple[float, ...]] = {}
-        lowered = {name.lower() for name in source.table.channels}
-        if set(PENDANT_COLUMNS) <= lowered:
-            coordinates = require_columns(source.table, PENDANT_COLUMNS, "the pendant")
-            for row, number in enumerate(columns["placement"]):
-                pendant.setdefault(int(number), tuple(coordinates[c][row] for c in PENDANT_COLUMNS))
-        errors = {axis: columns[axis] for axis in ("x", "y", "z")}
-        return columns["placement"], errors, pendant
-    session = source.session
-    numbers = [n for n in session.accepted_cycles if session.cycles[n].placement is not None]
-    if not numbers:
-        raise StationError(
-            f"{session.path}: the session has no accepted readings at a fixture placement yet."
-        )
-    errors = {
-        axis: np.asarray([session.cycles[n].readings[axis].value for n in numbers])
-        for axis in ("x", "y", "z")
-        if all(axis in session.cycles[n].readings for n in numbers)
-    }
-    pendant = {}
-    for event in session.input_events:
-        values, placement = event.get("values") or {}, event.get("placement")
-        if isinstance(placement, int) and all(
-            isinstance(values.get(axis), int | float) for axis in ("x", "y", "z")
-        ):
-            pendant[placement] = tuple(float(values[axis]) for axis in ("x", "y", "z"))
-    placements = np.asarray([session.cycles[n].placement for n in numbers])
-    return placements, errors, pendant
+
+def table_accuracy_inputs(table: Any) -> tuple[Any, dict[str, Any], dict[int, tuple[float, ...]]]:
+    """Placements, errors x, y, z and pendant coordinates of a relative-accuracy CSV."""
+    from station.session.tables import require_columns
+
+    columns = require_columns(table, ACCURACY_COLUMNS, "a relative-accuracy table")
+    pendant: dict[int, tuple[float, ...]] = {}
+    lowered = {name.lower() for name in table.channels}
+    if set(PENDANT_COLUMNS) <= lowered:
+        coordinates = require_columns(table, PENDANT_COLUMNS, "the pendant")
+        for row, number in enumerate(columns["placement"]):
+            pendant.setdefault(int(number), tuple(coordinates[c][row] for c in PENDANT_COLUMNS))
+    errors = {axis: columns[axis] for axis in ("x", "y", "z")}
+    return columns["placement"], errors, pendant
 
 
 def run(args: argparse.Namespace) -> int:
     """Analyse FILE and print the text report or the JSON document."""
     from station.analysis.capability import SpecLimits
     from station.analysis.report import format_report
-    from station.analysis.summary import AnalysisConfig, analyze, to_json
+    from station.analysis.summary import AnalysisConfig
 
     path = Path(args.file)
     lsl = parse_number(args.lsl, "--lsl")
@@ -346,52 +241,38 @@ def run(args: argparse.Namespace) -> int:
         raise StationError(f"--tolerance {args.tolerance!r} must be greater than 0.")
     if tolerance is not None and procedure != "linearity":
         raise StationError("--tolerance is the straightness tolerance of --procedure linearity.")
-    title = f"BASIC STATISTICS COMPREHENSIVE REPORT ON {path.name}"
-    document: dict[str, Any]
-    if procedure == "linearity":
-        from station.analysis.linearity import (
-            analyze_linearity,
-            linearity_json,
-            linearity_summary,
-            tolerance_from_limits,
-        )
-        from station.analysis.report import format_linearity
+    from station.session.report import judge, report_session
 
-        if tolerance is None:
-            tolerance = tolerance_from_limits(config)
-        result = analyze_linearity(
-            linearity_profiles(source, path), tolerance=tolerance, config=config
+    if isinstance(source, TableSource):
+        table = source.table
+        report = judge(
+            procedure,
+            config,
+            name=path.name,
+            channels=channels,
+            cycles=source.cycles,
+            excluded_cycles=(),
+            profiles=lambda: table_linearity_profiles(table),
+            accuracy_inputs=lambda: table_accuracy_inputs(table),
+            tolerance=tolerance,
         )
-        analysis = linearity_summary(result)
-        document = {**to_json(analysis), "linearity": linearity_json(result)}
-        sections = [format_linearity(result, analysis.config)]
-        title = f"LINEARITY REPORT ON {path.name}"
-    elif procedure == "relative_accuracy":
-        from station.analysis.accuracy import accuracy_json, analyze_accuracy
-        from station.analysis.report import format_accuracy
-
-        placements, errors, pendant = accuracy_inputs(source)
-        result = analyze_accuracy(
-            placements, errors, config, pendant=pendant, excluded_cycles=source.excluded_cycles
-        )
-        analysis = result.overall
-        document = {**to_json(analysis), "accuracy": accuracy_json(result)}
-        sections = [format_accuracy(result, config)]
-        title = f"RELATIVE ACCURACY REPORT ON {path.name}"
     else:
-        if not channels:
-            raise StationError(f"{path}: the session has no accepted readings to analyse yet.")
-        analysis = analyze(
-            channels, config, excluded_cycles=source.excluded_cycles, cycles=source.cycles
-        )
-        document = to_json(analysis)
-        sections = []
-    document["procedure"] = procedure
+        report = report_session(source, config=config, kind=procedure, tolerance=tolerance)
+    analysis = report.analysis
+    if analysis is None:
+        raise StationError(f"{path}: the session has no accepted readings to analyse yet.")
 
     if args.json:
-        print(json.dumps(document, indent=2, allow_nan=False))
+        print(json.dumps(report.document(), indent=2, allow_nan=False))
     else:
-        print(format_report(analysis, title=title, notes=source.notes, sections=sections))
+        print(
+            format_report(
+                analysis,
+                title=report.title,
+                notes=report.notes,
+                sections=[list(section) for section in report.sections],
+            )
+        )
     if args.fail_if_incapable:
         # A channel without a verdict (no limits, too few readings) fails too: a script that
         # asks for the verdict must not pass on data that was never judged.

@@ -21,8 +21,8 @@ TEST_CAPTURES = 5
 
 DEMO_PROCEDURES = {
     "repeatability": "three dial indicators in one fixture",
-    "relative_accuracy": "two fixtures far apart, with a teach pendant",
-    "linearity": "a parallel bar: indicators h, v and a linear scale s",
+    "relative_accuracy": "two fixtures and a teach pendant",
+    "linearity": "a bar, indicators h and v, a scale s",
 }
 """The procedures ``station demo`` simulates, with the set-up each one's simulator models."""
 

@@ -38,8 +38,10 @@ def brute_force_zone(s: np.ndarray, d: np.ndarray) -> float:
     for i, j in itertools.combinations(range(len(s)), 2):
         if s[i] == s[j]:
             continue
-        slope = (d[j] - d[i]) / (s[j] - s[i])
-        best = min(best, float(np.ptp(d - slope * s)))
+        with np.errstate(over="ignore"):
+            slope = (d[j] - d[i]) / (s[j] - s[i])
+        if np.isfinite(slope):  # two positions a hair apart define no usable direction
+            best = min(best, float(np.ptp(d - slope * s)))
     return best
 
 

@@ -21,9 +21,9 @@ if TYPE_CHECKING:
     from station.tui.app import StationApp
 
 INTRODUCTION = (
-    "Measures how well a robot returns to a taught position, by the 1990 NASA/KSC method: "
-    "three dial indicators on X, Y and Z, 25 to 30 cycles, judged with the mean, σ, skewness, "
-    "a histogram, a control chart and Cp/Cpk. Choose with ↑ ↓ and press Enter."
+    "Tests a robot by the 1990 NASA/KSC method: repeatability (25–30 returns to a taught "
+    "point), relative accuracy (two fixtures) or linearity (strokes along a bar), judged "
+    "with mean, σ, skewness, histogram, control chart and Cp/Cpk. ↑ ↓ and Enter choose."
 )
 
 

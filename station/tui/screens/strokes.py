@@ -303,10 +303,11 @@ class StrokeDashboardScreen(Screen[None]):
     def _load_recorded(self, path: Any) -> None:
         """After a resume: the whole strokes already recorded, as ``station analyze`` reads
         them, so the charts go on from them."""
-        from station.commands.analyze import linearity_profiles, load_session_source
+        from station.session.model import load_session
+        from station.session.report import session_linearity_profiles
 
         try:
-            self._profiles = list(linearity_profiles(load_session_source(path), path))
+            self._profiles = list(session_linearity_profiles(load_session(path, recover=False)))
         except StationError:
             self._profiles = []
         if self._profiles:

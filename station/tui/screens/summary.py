@@ -49,8 +49,9 @@ class SummaryView:
     excluded_cycles: tuple[int, ...] = ()
     notes: tuple[str, ...] = field(default_factory=tuple)
     report: Any = None
-    """A linearity or relative-accuracy session's own analysis (``ProcedureReport``): its
-    ``analysis`` is then what the verdict judges."""
+    """A linearity or relative-accuracy session's own analysis and report block
+    (``station.session.report.SessionReport``): its ``analysis`` is then what the verdict
+    judges."""
 
     @classmethod
     def from_live(cls, state: RunnerState, analysis: Any, header: Mapping[str, Any]) -> SummaryView:
@@ -72,10 +73,10 @@ class SummaryView:
     def from_file(cls, path: Path) -> SummaryView:
         """A saved session, read-only (the file is not changed, not even a torn tail)."""
         from station.session.model import load_session
-        from station.tui.review_analysis import analyze_session
+        from station.session.report import analyze_session
 
         session = load_session(path, recover=False)
-        report, notes = _procedure_report(path, session.header)
+        report, notes = _procedure_report(path, session.header, session)
         analysis = report.analysis if report is not None else analyze_session(session)
         if session.torn is not None:
             notes = (*notes, session.torn.message)
@@ -107,10 +108,18 @@ REPORT_WIDTH = 74
 """The procedure's report block fits the summary's column at 80×24 (scrollbar and padding)."""
 
 
-def _procedure_report(path: Path, header: Mapping[str, Any]) -> tuple[Any, tuple[str, ...]]:
+def _procedure_report(
+    path: Path, header: Mapping[str, Any], session: Any = None
+) -> tuple[Any, tuple[str, ...]]:
     """A linearity or relative-accuracy session's own analysis (None for repeatability), and
-    a note saying why there is none when its file has nothing to analyse yet."""
-    from station.tui.review_analysis import PROCEDURE_REPORTS, procedure_report
+    a note saying why there is none when its file has nothing to analyse yet. ``session``: the
+    file already loaded, when it is."""
+    from station.session.report import (
+        PROCEDURE_REPORTS,
+        load_session_source,
+        report_session,
+        session_source,
+    )
 
     procedure = header.get("procedure")
     recorded = procedure if isinstance(procedure, Mapping) else {"id": procedure}
@@ -119,7 +128,10 @@ def _procedure_report(path: Path, header: Mapping[str, Any]) -> tuple[Any, tuple
     if kind not in PROCEDURE_REPORTS and "analysis" in recorded:
         return None, ()
     try:
-        return procedure_report(path, REPORT_WIDTH), ()
+        source = load_session_source(path) if session is None else session_source(session)
+        if source.analysis not in PROCEDURE_REPORTS:
+            return None, ()
+        return report_session(source, width=REPORT_WIDTH), ()
     except StationError as error:
         return None, (error.message,)
 
@@ -290,7 +302,7 @@ class SummaryScreen(Screen[None]):
             if own is not None
             else f"BASIC STATISTICS COMPREHENSIVE REPORT ON {self.view.path.name}",
             notes=notes,
-            sections=[list(own.lines)] if own is not None else [],
+            sections=[list(section) for section in own.sections] if own is not None else [],
         )
         self._write(target, report, "report")
 
