@@ -145,10 +145,36 @@ def undefined_capability(
     )
 
 
-def point_cycles(cycles: Sequence[int], subgroup: int, points: int) -> list[tuple[int, ...]]:
+class PointCycles(Sequence[tuple[int, ...]]):
     """The cycle numbers behind each of the first ``points`` chart points: one cycle per point
-    for single readings, the ``subgroup`` consecutive cycles of each subgroup mean."""
-    return [tuple(cycles[i * subgroup : (i + 1) * subgroup]) for i in range(points)]
+    for single readings, the ``subgroup`` consecutive cycles of each subgroup mean.
+
+    Computed on demand: the rules look up only the points of their alarms, and building a
+    tuple per point of a million-point chart cost more than the rules themselves.
+    """
+
+    def __init__(self, cycles: Sequence[int], subgroup: int, points: int) -> None:
+        self._cycles = cycles
+        self._subgroup = subgroup
+        self._points = points
+
+    def __len__(self) -> int:
+        return self._points
+
+    def __getitem__(self, index):  # type: ignore[override]
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(self._points))]
+        if index < 0:
+            index += self._points
+        if not 0 <= index < self._points:
+            raise IndexError(index)
+        start = index * self._subgroup
+        return tuple(self._cycles[start : start + self._subgroup])
+
+
+def point_cycles(cycles: Sequence[int], subgroup: int, points: int) -> PointCycles:
+    """The cycle numbers behind each of the first ``points`` chart points (see PointCycles)."""
+    return PointCycles(cycles, subgroup, points)
 
 
 def cycle_labels(name: str, cycles: Sequence[int] | None, n: int) -> tuple[int, ...]:
