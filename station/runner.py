@@ -872,9 +872,12 @@ class Runner:
             # Said once per step: a streaming device sends many sets a second.
             if self._warned_position != self._position:
                 self._warned_position = self._position
+                # A streaming device (a scale counter, a data logger) sends all the time: that
+                # is normal, not a fault, so it is said calmly.
                 self._say(
-                    "warning",
-                    "Reading sets arrive while no capture step is current; they are not recorded.",
+                    "info",
+                    "The gauges are sending readings; none is recorded while no capture step "
+                    "is current.",
                 )
             return
         self._record(result, by="operator", position=position)
