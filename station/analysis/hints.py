@@ -82,9 +82,11 @@ def channel_hints(
         )
     if descriptive.mean is not None and offset_is_clear(descriptive, nominal):
         offset = descriptive.mean - nominal
+        # "off nominal (+0 in)" reads oddly; the nominal is named only when it is not zero.
+        where = "off nominal" if nominal == 0 else f"off the nominal {_figure(nominal, unit)}"
         hints.append(
-            f"{name}: the average is {_figure(offset, unit)} off nominal "
-            f"({_figure(nominal, unit)}), more than chance explains with {descriptive.n} "
+            f"{name}: the average is {_figure(offset, unit)} {where}, "
+            f"more than chance explains with {descriptive.n} "
             "readings; the report attributes this to the linearisation of the inverse "
             "kinematics or to the ambient temperature."
         )
