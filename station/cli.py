@@ -15,6 +15,7 @@ import sys
 from collections.abc import Sequence
 
 from station import __version__
+from station.commands._remedies import CLI_REMEDIES
 from station.errors import StationError
 
 
@@ -65,7 +66,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args) or 0)
     except StationError as error:
-        print(f"station: {error.message}", file=sys.stderr)
+        print(f"station: {error.worded(CLI_REMEDIES)}", file=sys.stderr)
         return error.exit_code
     except KeyboardInterrupt:
         print("station: interrupted", file=sys.stderr)

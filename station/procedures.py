@@ -59,12 +59,99 @@ from typing import Any, Literal
 
 from station.errors import StationError
 
-StepKind = Literal["check", "input", "zero", "capture", "cycles", "stroke", "repeat"]
-STEP_KINDS: tuple[str, ...] = ("check", "input", "zero", "capture", "cycles", "stroke", "repeat")
+StepKind = str
+"""A step kind: one of :func:`step_kinds` (the built-ins, and any a handler registered)."""
 UNITS: tuple[str, ...] = ("in", "mm")
-AnalysisKind = Literal["repeatability", "relative_accuracy", "linearity"]
-ANALYSIS_KINDS: tuple[str, ...] = ("repeatability", "relative_accuracy", "linearity")
-"""How a procedure's sessions are analysed (``station analyze``, the summary)."""
+AnalysisKind = str
+"""An analysis kind: one of :func:`analysis_kinds`."""
+
+
+@dataclass(frozen=True)
+class StepSchema:
+    """What a step kind may hold in a procedure file, beyond ``id``, ``kind``, ``title`` and
+    ``text``: its own ``keys``, and which shared parts apply (so the loader validates a kind it
+    has never seen the code of)."""
+
+    keys: tuple[str, ...] = ()
+    channels: bool = False
+    """``channels`` (default: all the procedure's)."""
+    counts: bool = False
+    """``min``/``target`` and a ``prompt`` (cycle or stroke counts)."""
+    fields: bool = False
+    """``fields`` typed by the operator."""
+    direction: bool = False
+    """``direction_channel``: the channel tracking the position along a stream."""
+    block: bool = False
+    """A block of inner ``steps`` repeated ``target`` times (no nesting)."""
+    implies_analysis: str | None = None
+    """The analysis kind a procedure holding this step defaults to."""
+
+    @property
+    def allowed(self) -> tuple[str, ...]:
+        """Every key a step of this kind may have beyond the common ones."""
+        shared = (
+            (("channels",) if self.channels else ())
+            + (("min", "target", "prompt") if self.counts else ())
+            + (("fields",) if self.fields else ())
+            + (("direction_channel",) if self.direction else ())
+            + (("label", "min", "target", "prompt", "steps") if self.block else ())
+        )
+        return tuple(dict.fromkeys(shared + self.keys))
+
+
+_STEP_SCHEMAS: dict[str, StepSchema] = {
+    "check": StepSchema(),
+    "input": StepSchema(fields=True),
+    "zero": StepSchema(channels=True),
+    "capture": StepSchema(channels=True),
+    "cycles": StepSchema(channels=True, counts=True),
+    "stroke": StepSchema(channels=True, counts=True, direction=True, implies_analysis="linearity"),
+    "repeat": StepSchema(block=True, implies_analysis="relative_accuracy"),
+}
+
+
+@dataclass(frozen=True)
+class AnalysisNeeds:
+    """What a procedure must hold for an analysis kind: a step of a kind with ``facet`` (e.g.
+    ``direction`` for streamed strokes, ``block`` for placements) and these ``channels``."""
+
+    facet: str | None = None
+    facet_words: str = ""
+    channels: tuple[str, ...] = ()
+
+
+_ANALYSES: dict[str, AnalysisNeeds] = {
+    "repeatability": AnalysisNeeds(),
+    "relative_accuracy": AnalysisNeeds(
+        facet="block", facet_words="a repeat block (one per placement)", channels=("x", "y", "z")
+    ),
+    "linearity": AnalysisNeeds(facet="direction", facet_words="a stroke step (streamed strokes)"),
+}
+
+
+def register_step_schema(kind: str, schema: StepSchema) -> None:
+    """Let procedure files use step kind ``kind`` with ``schema`` (called by the step-handler
+    registry when a handler is registered)."""
+    if not _ID_PATTERN.match(kind):
+        raise ValueError(f"a step kind is a plain name, not {kind!r}")
+    _STEP_SCHEMAS[kind] = schema
+
+
+def register_analysis_needs(kind: str, needs: AnalysisNeeds) -> None:
+    """Let procedure files declare ``analysis = kind`` (called by the analysis-kind registry)."""
+    _ANALYSES[kind] = needs
+
+
+def step_kinds() -> tuple[str, ...]:
+    """The step kinds a procedure file may use."""
+    return tuple(_STEP_SCHEMAS)
+
+
+def analysis_kinds() -> tuple[str, ...]:
+    """The analysis kinds a procedure file may declare."""
+    return tuple(_ANALYSES)
+
+
 DEFAULT_CYCLES_MIN = 25
 DEFAULT_CYCLES_TARGET = 30
 PROCEDURES_ENV = "STATION_PROCEDURES"
@@ -107,6 +194,8 @@ class Step:
     steps: tuple[Step, ...] = ()
     number: str = ""
     """Where the step is in the file, 1-based: ``"3"``, or ``"5.2"`` inside a repeat block."""
+    options: Mapping[str, Any] = field(default_factory=dict)
+    """The values of the keys a registered step kind declares as its own (``schema.keys``)."""
 
     def prompt_for(self, cycle: int, count: int) -> str:
         """The per-cycle prompt with ``{cycle}`` and ``{count}`` filled in (plain substitution)."""
@@ -312,15 +401,6 @@ _TOP_KEYS = (
     "steps",
 )
 _COMMON_STEP_KEYS = ("id", "kind", "title", "text")
-_STEP_KEYS: dict[str, tuple[str, ...]] = {
-    "check": (),
-    "input": ("fields",),
-    "zero": ("channels",),
-    "capture": ("channels",),
-    "cycles": ("channels", "min", "target", "prompt"),
-    "stroke": ("channels", "direction_channel", "min", "target", "prompt"),
-    "repeat": ("label", "min", "target", "prompt", "steps"),
-}
 _FIELD_KEYS = ("name", "label", "type", "unit", "required")
 
 
@@ -404,27 +484,30 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
 def _analysis_kind(
     check: _Checker, declared: Any, steps: tuple[Step, ...], channels: tuple[str, ...]
 ) -> AnalysisKind:
-    """The declared analysis kind, checked against what the steps record; else the default."""
-    kinds = {step.kind for step in steps} | {inner.kind for step in steps for inner in step.steps}
+    """The declared analysis kind, checked against what the steps record; else the default
+    the steps imply (a stroke step: linearity; a repeat block: relative accuracy)."""
+    every_step = [inner for step in steps for inner in (step, *step.steps)]
+    schemas = [_STEP_SCHEMAS[step.kind] for step in every_step]
     if declared is None:
-        if "stroke" in kinds:
-            return "linearity"
-        return "relative_accuracy" if "repeat" in kinds else "repeatability"
-    if declared not in ANALYSIS_KINDS:
+        # The first kind the steps imply whose channels the procedure has (a repeat block over
+        # x alone is judged as repeatability).
+        implied = [
+            schema.implies_analysis
+            for schema in schemas
+            if schema.implies_analysis
+            and set(_ANALYSES[schema.implies_analysis].channels) <= set(channels)
+        ]
+        return implied[0] if implied else "repeatability"
+    if declared not in _ANALYSES:
+        raise check.fail("", f"'analysis' must be one of {', '.join(_ANALYSES)}, not {declared!r}")
+    needs = _ANALYSES[declared]
+    if needs.facet and not any(getattr(schema, needs.facet) for schema in schemas):
+        raise check.fail("", f"'analysis' {declared} needs {needs.facet_words}")
+    if not set(needs.channels) <= set(channels):
         raise check.fail(
-            "", f"'analysis' must be one of {', '.join(ANALYSIS_KINDS)}, not {declared!r}"
+            "", f"'analysis' {declared} needs the channels {', '.join(needs.channels)}"
         )
-    # The linearity analysis reads streamed strokes; relative accuracy, captures per placement.
-    if declared == "linearity" and "stroke" not in kinds:
-        raise check.fail("", "'analysis' linearity needs a stroke step (streamed strokes)")
-    if declared == "relative_accuracy":
-        if "repeat" not in kinds:
-            raise check.fail(
-                "", "'analysis' relative_accuracy needs a repeat block (one per placement)"
-            )
-        if not {"x", "y", "z"} <= set(channels):
-            raise check.fail("", "'analysis' relative_accuracy needs the channels x, y and z")
-    return declared
+    return str(declared)
 
 
 def _parse_limits(
@@ -489,11 +572,14 @@ def _parse_step(context: _StepContext, raw: Any, number: str, *, nested: bool = 
         )
     context.seen[step_id] = number
     kind = check.text(raw, "kind", where)
-    if kind not in STEP_KINDS:
-        raise check.fail(where, f"unknown step kind {kind!r}; known kinds: {', '.join(STEP_KINDS)}")
-    if kind == "repeat" and nested:
+    schema = _STEP_SCHEMAS.get(kind)
+    if schema is None:
+        raise check.fail(
+            where, f"unknown step kind {kind!r}; known kinds: {', '.join(_STEP_SCHEMAS)}"
+        )
+    if schema.block and nested:
         raise check.fail(where, "a repeat block cannot hold another repeat block")
-    check.only_keys(raw, _COMMON_STEP_KEYS + _STEP_KEYS[kind], f"{where}, kind {kind}")
+    check.only_keys(raw, _COMMON_STEP_KEYS + schema.allowed, f"{where}, kind {kind}")
     values: dict[str, Any] = {
         "id": step_id,
         "kind": kind,
@@ -501,7 +587,7 @@ def _parse_step(context: _StepContext, raw: Any, number: str, *, nested: bool = 
         "text": check.get(raw, "text", str, where, required=False, default="").strip(),
         "number": number,
     }
-    if kind in ("zero", "capture", "cycles", "stroke"):
+    if schema.channels:
         channels = check.names(raw, "channels", where, required=False) or context.channels
         missing = [c for c in channels if c not in context.channels]
         if missing:
@@ -511,11 +597,11 @@ def _parse_step(context: _StepContext, raw: Any, number: str, *, nested: bool = 
                 f"(its channels: {', '.join(context.channels)})",
             )
         values["channels"] = channels
-    if kind in ("cycles", "stroke", "repeat"):
+    if schema.counts or schema.block:
         values["prompt"] = check.get(raw, "prompt", str, where, required=False, default="")
         count_min = check.count(raw, "min", where, required=False)
         count_target = check.count(raw, "target", where, required=False)
-        if kind == "repeat":
+        if schema.block:
             if count_target is None:
                 raise check.fail(where, "missing required key 'target' (repetitions)")
             count_min = count_min or count_target
@@ -525,9 +611,9 @@ def _parse_step(context: _StepContext, raw: Any, number: str, *, nested: bool = 
         if count_min > count_target:
             raise check.fail(where, f"min {count_min} is more than target {count_target}")
         values["count_min"], values["count_target"] = count_min, count_target
-    if kind == "input":
+    if schema.fields:
         values["fields"] = _parse_fields(check, raw, where)
-    if kind == "stroke":
+    if schema.direction:
         direction = check.text(raw, "direction_channel", where)
         if direction not in values["channels"]:
             raise check.fail(
@@ -536,7 +622,7 @@ def _parse_step(context: _StepContext, raw: Any, number: str, *, nested: bool = 
                 f"({', '.join(values['channels'])})",
             )
         values["direction_channel"] = direction
-    if kind == "repeat":
+    if schema.block:
         values["label"] = check.get(raw, "label", str, where, required=False, default="placement")
         inner = check.get(raw, "steps", list, where)
         if not inner:
@@ -545,6 +631,9 @@ def _parse_step(context: _StepContext, raw: Any, number: str, *, nested: bool = 
             _parse_step(context, item, f"{number}.{index}", nested=True)
             for index, item in enumerate(inner, start=1)
         )
+    own = {key: raw[key] for key in schema.keys if key in raw}
+    if own:
+        values["options"] = own
     return Step(**values)
 
 
@@ -627,7 +716,7 @@ def discover_procedures(
     for folder in user_dirs:
         if not folder.is_dir():
             raise StationError(
-                f"procedures folder {folder} does not exist (from --procedures or "
+                f"procedures folder {folder} does not exist (from the command line or "
                 f"{PROCEDURES_ENV}); create it or fix the path"
             )
         if folder.resolve() != builtin.resolve():

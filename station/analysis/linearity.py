@@ -49,7 +49,7 @@ DIRECTIONS = (A_TO_B, B_TO_A)
 INDICATORS = ("h", "v")
 SCALE = "s"
 NO_TOLERANCE_MESSAGE = (
-    "no straightness tolerance: give --tolerance T or limits on h and v in the procedure"
+    "no straightness tolerance: give a tolerance, or limits on h and v in the procedure"
 )
 
 
@@ -208,44 +208,91 @@ def _direction(sign: float, a_to_b: int) -> str:
     return A_TO_B if sign * a_to_b > 0 else B_TO_A
 
 
+DEADBAND_RESOLUTIONS = 100
+"""The stroke split's deadband, in gauge resolutions: a reversal smaller than this is scale
+noise or a dwell at an end, never a turn."""
+
+
+def stroke_deadband(resolution: float) -> float:
+    """The one deadband rule of a session's stroke split (live and batch): 100 resolutions of
+    the scale. The engine records it in the session header; a table without one falls back to
+    2 % of its whole travel (:func:`split_strokes`)."""
+    return DEADBAND_RESOLUTIONS * float(resolution)
+
+
+class Hysteresis:
+    """The point-by-point step of the stroke split, shared by the batch split
+    (:func:`turning_points`) and the live one (:class:`TravelTracker`): a direction of travel
+    changes only when the scale comes back from its running extreme by more than ``deadband``.
+
+    :meth:`step` answers ``rest`` (not moving yet), ``start`` (the first move beyond the
+    deadband: :attr:`start_index` is where it began), ``beyond`` (a new extreme), ``back`` (within
+    the deadband of the extreme) or ``turn`` (a reversal: :attr:`turned_at` is the extreme's
+    index, the direction has flipped)."""
+
+    def __init__(self, deadband: float) -> None:
+        self.deadband = float(deadband)
+        self.direction = 0
+        self.extreme = math.nan
+        self.extreme_index = -1
+        self.start_index = -1
+        self.turned_at = -1
+        self._low = self._high = math.nan
+        self._low_index = self._high_index = -1
+
+    def step(self, value: float, index: int) -> str:
+        """Take the scale reading ``value`` of point ``index``."""
+        if self.direction == 0:
+            if math.isnan(self._low) or value < self._low:
+                self._low, self._low_index = value, index
+            if math.isnan(self._high) or value > self._high:
+                self._high, self._high_index = value, index
+            if value - self._low > self.deadband:
+                self.direction, self.start_index = 1, self._low_index
+            elif self._high - value > self.deadband:
+                self.direction, self.start_index = -1, self._high_index
+            else:
+                return "rest"
+            self.extreme, self.extreme_index = value, index
+            return "start"
+        if (value >= self.extreme) if self.direction > 0 else (value <= self.extreme):
+            self.extreme, self.extreme_index = value, index
+            return "beyond"
+        if abs(value - self.extreme) > self.deadband:
+            self.turned_at = self.extreme_index
+            self.direction = -self.direction
+            self.extreme, self.extreme_index = value, index
+            return "turn"
+        return "back"
+
+    def rest(self, values: Sequence[float], first_index: int) -> None:
+        """Start over at rest with ``values`` (the points that waited at an end)."""
+        self.direction = 0
+        self._low = self._high = math.nan
+        for offset, value in enumerate(values):
+            self.step(value, first_index + offset)
+
+
 def turning_points(s: Any, deadband: float) -> list[int]:
     """Indices of the ends of travel of s: the extremes between reversals larger than
-    ``deadband`` (hysteresis, so noise and dwell at an end do not make false reversals).
-    The first and last entries are where the travel starts and where it last ends."""
+    ``deadband`` (:class:`Hysteresis`, so noise and dwell at an end do not make false
+    reversals). The first and last entries are where the travel starts and where it last
+    ends."""
     import numpy as np
 
     s = np.asarray(s, dtype=float)
     if s.size == 0:
         return []
     points = [0]
-    direction = 0
-    extreme = 0  # the index of the running extreme in the current direction
-    low = high = 0  # before the first move: the running minimum and maximum
-    for i in range(1, s.size):
-        value = s[i]
-        if direction == 0:
-            if value < s[low]:
-                low = i
-            if value > s[high]:
-                high = i
-            if value - s[low] > deadband:
-                direction, extreme, points[0] = 1, i, low
-            elif s[high] - value > deadband:
-                direction, extreme, points[0] = -1, i, high
-        elif direction > 0:
-            if value >= s[extreme]:
-                extreme = i
-            elif s[extreme] - value > deadband:
-                points.append(extreme)
-                direction, extreme = -1, i
-        else:
-            if value <= s[extreme]:
-                extreme = i
-            elif value - s[extreme] > deadband:
-                points.append(extreme)
-                direction, extreme = 1, i
-    if direction != 0:
-        points.append(extreme)
+    hysteresis = Hysteresis(deadband)
+    for index, value in enumerate(s.tolist()):
+        event = hysteresis.step(value, index)
+        if event == "start":
+            points[0] = hysteresis.start_index
+        elif event == "turn":
+            points.append(hysteresis.turned_at)
+    if hysteresis.direction != 0:
+        points.append(hysteresis.extreme_index)
     return points
 
 
@@ -319,6 +366,28 @@ def split_strokes(
     return strokes
 
 
+def trim_dwell(s: Any, deadband: float | None = None) -> np.ndarray:
+    """The indices of one whole stroke's points without the dwell at its ends (as
+    :func:`split_strokes` leaves it out: points within a tenth of the ``deadband`` of an end's
+    level, but for the last point before leaving and the first on arriving). A stroke split
+    live is trimmed, never split again."""
+    import numpy as np
+
+    s = np.asarray(s, dtype=float).ravel()
+    everything = np.arange(s.size)
+    if s.size < 2 or not np.all(np.isfinite(s)) or float(np.ptp(s)) == 0:
+        return everything
+    deadband = 0.02 * float(np.ptp(s)) if deadband is None else float(deadband)
+    dwell_band = deadband / 10
+    end = int(np.argmax(np.abs(s - s[0])))
+    start_level, end_level = _end_level(s, 0, deadband), _end_level(s, end, deadband)
+    left = np.flatnonzero(np.abs(s - start_level) > dwell_band)
+    arrived = np.flatnonzero(np.abs(s - end_level) <= dwell_band)
+    first = max(int(left[0]) - 1, 0) if left.size else 0
+    last = int(arrived[0]) if arrived.size else s.size - 1
+    return everything[first : last + 1] if last > first else everything
+
+
 @dataclass(frozen=True)
 class TravelEvent:
     """What :class:`TravelTracker` learnt from a point: ``points`` (tokens, in order) now
@@ -362,10 +431,9 @@ class TravelTracker:
         self.still_seconds = float(still_seconds)
         self.rest_points = int(rest_points)
         self.a_to_b = a_to_b
-        self._direction = 0
-        self._extreme = 0.0
+        self._hysteresis = Hysteresis(deadband)
+        self._count = 0
         self._extreme_t = 0.0
-        self._low = self._high = math.nan
         self._resting = 0
         self._from_rest_or_turn = False
         self._waiting: list[Any] = []
@@ -374,48 +442,43 @@ class TravelTracker:
     @property
     def moving(self) -> bool:
         """True once the segment under way has left its start by more than the deadband."""
-        return self._direction != 0
+        return self._hysteresis.direction != 0
 
     def add(self, token: Any, s: float, t: float) -> list[TravelEvent]:
         """Take one point (scale reading ``s`` at monotonic time ``t``)."""
-        events: list[TravelEvent] = []
-        if self._direction == 0:
-            if math.isnan(self._low):
-                self._low = self._high = s
-            self._low, self._high = min(self._low, s), max(self._high, s)
-            if s - self._low > self.deadband or self._high - s > self.deadband:
-                self._direction = 1 if s - self._low > self.deadband else -1
+        index, self._count = self._count, self._count + 1
+        was_moving = self._hysteresis.direction
+        event = self._hysteresis.step(s, index)
+        if not was_moving:
+            if event == "start":
                 self._from_rest_or_turn = self._from_rest_or_turn or (
                     self._resting >= self.rest_points
                 )
-                self._extreme, self._extreme_t = s, t
+                self._extreme_t = t
             else:
                 self._resting += 1
             return [TravelEvent("points", (token,))]
-        beyond = s >= self._extreme if self._direction > 0 else s <= self._extreme
-        if beyond:
-            self._extreme, self._extreme_t = s, t
+        events: list[TravelEvent] = []
+        if event == "beyond":
+            self._extreme_t = t
             events.append(TravelEvent("points", (*self._waiting, token)))
             self._waiting, self._waiting_values = [], []
             return events
-        if abs(s - self._extreme) > self.deadband:
-            events.append(self._close())
-            self._direction = -self._direction
+        if event == "turn":
+            events.append(self._close(was_moving))
             self._from_rest_or_turn = True
-            self._extreme, self._extreme_t = s, t
+            self._extreme_t = t
             events.append(TravelEvent("points", (*self._waiting, token)))
             self._waiting, self._waiting_values = [], []
             return events
         self._waiting.append(token)
         self._waiting_values.append(s)
         if t - self._extreme_t >= self.still_seconds:
-            events.append(self._close())
+            events.append(self._close(was_moving))
             # Still at an end: the next segment starts at rest with the points that waited.
-            self._direction = 0
             self._from_rest_or_turn = True
             self._resting = len(self._waiting)
-            self._low = min(self._waiting_values)
-            self._high = max(self._waiting_values)
+            self._hysteresis.rest(self._waiting_values, index - len(self._waiting) + 1)
             events.append(TravelEvent("points", tuple(self._waiting)))
             self._waiting, self._waiting_values = [], []
         return events
@@ -426,10 +489,10 @@ class TravelTracker:
         waiting, self._waiting, self._waiting_values = self._waiting, [], []
         return waiting
 
-    def _close(self) -> TravelEvent:
+    def _close(self, direction: int) -> TravelEvent:
         return TravelEvent(
             "close",
-            direction=_direction(float(self._direction), self.a_to_b),
+            direction=_direction(float(direction), self.a_to_b),
             stroke=self._from_rest_or_turn,
         )
 

@@ -29,7 +29,7 @@ from station.analysis.rules import RULE_SETS, Alarm, check_rules
 from station.analysis.spatial import AXES, Spatial, find_axes, spatial_figures
 from station.errors import StationError
 
-NO_LIMITS_MESSAGE = "no specification limits: give --lsl/--usl or --limit CH=LSL:USL"
+NO_LIMITS_MESSAGE = "no specification limits: give limits for this channel"
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 from station.commands._args import parse_number
 from station.errors import StationError
-from station.procedures import ANALYSIS_KINDS
+from station.procedures import analysis_kinds
 
 if TYPE_CHECKING:
     from station.analysis.summary import AnalysisConfig
@@ -89,9 +89,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--unit", default="", help="unit of the readings, for the report")
     parser.add_argument(
         "--procedure",
-        choices=ANALYSIS_KINDS,
         metavar="KIND",
-        help=f"what FILE holds: {', '.join(ANALYSIS_KINDS)} (default: the analysis a "
+        help=f"what FILE holds: {', '.join(analysis_kinds())} (default: the analysis a "
         "session's procedure declares, else repeatability)",
     )
     parser.add_argument(
@@ -143,7 +142,7 @@ def load_source(path: Path) -> Any:
     """A session file (detected by its header: a ``SessionSource``) or a CSV table of readings
     (a ``TableSource``)."""
     if path.is_file() and is_session_file(path):
-        from station.session.report import load_session_source
+        from station.verdicts import load_session_source
 
         return load_session_source(path)
     from station.session.tables import read_table
@@ -241,21 +240,21 @@ def run(args: argparse.Namespace) -> int:
         raise StationError(f"--tolerance {args.tolerance!r} must be greater than 0.")
     if tolerance is not None and procedure != "linearity":
         raise StationError("--tolerance is the straightness tolerance of --procedure linearity.")
-    from station.session.report import judge, report_session
+    from station.verdicts import KindInputs, judge, report_session
 
     if isinstance(source, TableSource):
         table = source.table
-        report = judge(
-            procedure,
-            config,
-            name=path.name,
+        inputs = KindInputs(
+            config=config,
             channels=channels,
             cycles=source.cycles,
             excluded_cycles=(),
             profiles=lambda: table_linearity_profiles(table),
             accuracy_inputs=lambda: table_accuracy_inputs(table),
             tolerance=tolerance,
+            options={},
         )
+        report = judge(procedure, inputs, name=path.name)
     else:
         report = report_session(source, config=config, kind=procedure, tolerance=tolerance)
     analysis = report.analysis

@@ -1,7 +1,7 @@
 """``station capture``: the headless run of a procedure, for scripts and for a terminal without
 the TUI.
 
-It drives the same :class:`~station.runner.Runner` as the TUI: check steps are confirmed by the
+It drives the same :class:`~station.run.Runner` as the TUI: check steps are confirmed by the
 command itself (the file records ``by: "station capture"``), input steps take ``--input``
 values, zero steps zero, and each cycle is captured until the cycles step has its count. A
 ``cycle N ...`` line is printed only once that cycle's event is on disk (fsynced), so every line
@@ -16,7 +16,7 @@ pendant's display there. Every value is checked before anything is written.
 
 Linearity (a ``stroke`` step, ``--strokes N``): h, v and s stream without a pause (use
 ``--trigger push`` with a counter that sends continuously); the strokes are split live by the
-scale's direction of travel (:meth:`~station.runner.Runner.stream_strokes`), and a line
+scale's direction of travel (:meth:`~station.run.Runner.stream_strokes`), and a line
 ``stroke 7 A→B 412 points h=0.00123 v=0.00061 (LS straightness)`` is printed once that
 stroke's points are on disk. The command stops after N whole strokes and ends with the
 procedure's report (the same as ``station analyze FILE``).
@@ -57,6 +57,7 @@ import threading
 from pathlib import Path
 from typing import Any
 
+from station.commands._remedies import CLI_REMEDIES
 from station.errors import StationError
 
 BY = "station capture"
@@ -252,7 +253,7 @@ def _setup(args: argparse.Namespace) -> Any:
     from station.analysis.capability import SpecLimits
     from station.commands.analyze import parse_limit
     from station.procedures import discover_procedures
-    from station.runner import PortSetup, SessionSetup
+    from station.run import PortSetup, SessionSetup
 
     missing = [
         flag
@@ -304,7 +305,7 @@ def _channel_map(args: argparse.Namespace, channels: tuple[str, ...]) -> dict[st
 
 
 def _resume_setup(args: argparse.Namespace) -> Any:
-    from station.runner import PortSetup, resume_setup
+    from station.run import PortSetup, resume_setup
 
     setup = resume_setup(args.resume, procedures_dirs=args.procedures)
     conflicts = _resume_conflicts(args, setup)
@@ -371,7 +372,7 @@ def _check_answerable(runner_plan: Any, procedure: Any, inputs: Inputs, done: se
     (``runner_plan``: the unrolled steps as (step, placement); ``done``: the (step id,
     placement) pairs a resumed session already confirmed)."""
     for step, placement in runner_plan:
-        if (step.id, placement) in done or step.kind != "input":
+        if (step.id, placement) in done or not step.fields:
             continue
         given = _values_for(inputs, placement)
         needed = [f.name for f in step.fields if f.required and f.name not in given]
@@ -420,6 +421,7 @@ class _Headless:
         self.done = threading.Event()
         self.push = runner.setup.trigger == "push"
         self._waiting = False
+        self._refused = 0
 
     def run(self) -> None:
         try:
@@ -448,68 +450,81 @@ class _Headless:
         self._waiting = True
 
     def _walk(self) -> None:
+        """Do what the engine asks next until every step is done: one small call per action
+        (the same actions the TUI maps to keys)."""
         runner = self.runner
-        refused = 0
         while True:
             state = runner.state()
-            if state.status != "running" or state.current is None:
+            if state.status != "running" or state.action.kind in ("finish", "done"):
                 return
-            step = state.current.step
-            if step.kind == "check":
-                runner.confirm(by=BY)
-            elif step.kind == "zero":
-                seen = self._readings_seen()
-                try:
-                    runner.zero(by=BY, timeout=self.timeout)
-                except StationError:
-                    if self.push and self._readings_seen() == seen:
-                        self._idle(step)  # nobody pressed DATA yet: the zero waits for them
-                        continue
-                    raise
-                self._waiting = False
-            elif step.kind == "input":
-                given = _values_for(self.inputs, state.current.placement)
-                # _check_answerable made sure every required field has a value; the runner
-                # checks them.
-                values = {f.name: given[f.name] for f in step.fields if f.name in given}
-                runner.submit_input(values, by=BY)
-            elif step.kind == "stroke" and state.strokes >= state.strokes_target:
-                runner.confirm(by=BY)
-            elif step.kind == "stroke":
-                runner.stream_strokes(
-                    self.timeout,
-                    deadband=self.deadband,
-                    still_seconds=self.still,
-                    on_stroke=_print_stroke,
-                    by=BY,
-                )
-            elif step.kind == "cycles" and state.cycle >= state.cycles_target:
-                runner.confirm(by=BY)
-            elif step.kind in ("cycles", "capture"):
-                seen = self._readings_seen()
-                outcome = runner.capture(self.timeout, by=BY)
-                if runner.state().status != "running":
-                    return
-                if outcome.recorded:
-                    refused = 0
-                elif self.push and self._readings_seen() == seen:
-                    self._idle(step)  # no reading at all: the operator has not pressed DATA yet
-                    continue
-                elif outcome.port_down:
-                    continue  # the line is reconnecting: not the gauges' refusal; wait for it
-                else:
-                    refused += 1
-                self._waiting = False
-                if refused >= self.attempts:
-                    raise StationError(
-                        f"{refused} reading sets in a row were refused (last: "
-                        f"{outcome.message}); check the gauges and the cable, "
-                        f"then resume with `station capture --resume {runner.path}`"
-                    )
-            else:
-                raise StationError(
-                    f"station capture cannot run {step.kind} steps yet (step {step.title!r})"
-                )
+            self._ACTIONS[state.action.kind](self, state)
+
+    def _confirm(self, state: Any) -> None:
+        self.runner.confirm(by=BY)
+
+    def _input(self, state: Any) -> None:
+        given = _values_for(self.inputs, state.placement)
+        # _check_answerable made sure every required field has a value; the engine checks them.
+        fields = state.action.fields
+        self.runner.submit_input({f.name: given[f.name] for f in fields if f.name in given}, by=BY)
+
+    def _zero(self, state: Any) -> None:
+        seen = self._readings_seen()
+        try:
+            self.runner.zero(by=BY, timeout=self.timeout)
+        except StationError:
+            if self.push and self._readings_seen() == seen:
+                self._idle(state.current.step)  # nobody pressed DATA yet: the zero waits
+                return
+            raise
+        self._waiting = False
+
+    def _stream(self, state: Any) -> None:
+        if state.progress is not None and state.progress.complete:
+            self.runner.confirm(by=BY)
+            return
+        self.runner.stream_strokes(
+            self.timeout,
+            deadband=self.deadband,
+            still_seconds=self.still,
+            on_stroke=_print_stroke,
+            by=BY,
+        )
+
+    def _capture(self, state: Any) -> None:
+        runner = self.runner
+        if state.progress is not None and state.progress.complete:
+            runner.confirm(by=BY)
+            return
+        seen = self._readings_seen()
+        outcome = runner.capture(self.timeout, by=BY)
+        if runner.state().status != "running":
+            return
+        if outcome.recorded:
+            self._refused = 0
+        elif self.push and self._readings_seen() == seen:
+            self._idle(state.current.step)  # no reading at all: nobody pressed DATA yet
+            return
+        elif outcome.port_down:
+            return  # the line is reconnecting: not the gauges' refusal; wait for it
+        else:
+            self._refused += 1
+        self._waiting = False
+        if self._refused >= self.attempts:
+            raise StationError(
+                f"{self._refused} reading sets in a row were refused (last: "
+                f"{outcome.message}); check the gauges and the cable",
+                remedy="resume_session",
+                subject=str(runner.path),
+            )
+
+    _ACTIONS: dict[str, Any] = {
+        "confirm": _confirm,
+        "input": _input,
+        "zero": _zero,
+        "stream": _stream,
+        "capture": _capture,
+    }
 
 
 def _print_stroke(outcome: Any) -> None:
@@ -537,7 +552,7 @@ class _Printer:
         self._last_warning: str | None = None
 
     def __call__(self, notice: Any) -> None:
-        from station.runner import CycleRecord
+        from station.run import CycleRecord
 
         event = notice.event
         kind = event.get("type") if event is not None else None
@@ -607,7 +622,7 @@ def _frames_carry_unit(protocol: Any) -> bool:
 
 def run(args: argparse.Namespace) -> int:
     """Run (or resume) a session headless; the exit code says how it ended."""
-    from station.runner import Runner, open_gauges
+    from station.run import Runner, open_gauges
     from station.session.store import sessions_folder
 
     timeout = _positive(args.timeout, "--timeout")
@@ -626,7 +641,7 @@ def run(args: argparse.Namespace) -> int:
         }
     else:
         setup, done = _setup(args), set()
-    from station.runner import plan_steps
+    from station.run import plan_steps
 
     _check_answerable(plan_steps(setup), setup.procedure, inputs, done)
 
@@ -724,33 +739,38 @@ def _ended(runner: Any, headless: _Headless) -> int | None:
     return None
 
 
-_PROCEDURE_REPORTS = ("linearity", "relative_accuracy")
-"""Procedures whose report is their own (straightness, accuracy per placement), as
-``station analyze FILE`` prints it."""
-
-
-def _print_procedure_report(path: Path) -> None:
-    from station.commands import analyze
-
-    parser = argparse.ArgumentParser(prog="station")
-    analyze.add_parser(parser.add_subparsers())
-    analyze.run(parser.parse_args(["analyze", str(path)]))
-
-
 def _print_summary(runner: Any, analysis: Any) -> None:
+    """The session's report as ``station analyze FILE`` prints it (through the analysis-kind
+    registry, so a site's own procedure of a kind gets that kind's report)."""
     from station.analysis.report import format_report
+    from station.verdicts import analyze_session_file
 
-    notes = [
-        f"Robot {runner.setup.robot}, operator {runner.setup.operator or 'not given'}, "
-        f"procedure {runner.setup.procedure.id} {runner.setup.procedure.version}.",
-        f"Session file: {runner.path}",
-        f"Last line hash (anchors the session file): {runner.last_hash}",
-    ]
-    if runner.setup.procedure.id in _PROCEDURE_REPORTS:
-        _print_procedure_report(runner.path)
-    elif analysis is not None:
-        print(format_report(analysis, notes=notes), end="")
-    else:
+    report = None
+    if analysis is None:
         print("no accepted cycles: nothing to analyse")
+    else:
+        try:
+            report = analyze_session_file(Path(runner.path))
+        except StationError as error:
+            # The session is finished and safe; only its report could not be made.
+            print(f"no report: {error.worded(CLI_REMEDIES)}")
+            report = None
+    if report is not None:
+        notes = [
+            f"Robot {runner.setup.robot}, operator {runner.setup.operator or 'not given'}, "
+            f"procedure {runner.setup.procedure.id} {runner.setup.procedure.version}.",
+            f"Session file: {runner.path}",
+            f"Last line hash (anchors the session file): {runner.last_hash}",
+        ]
+        if report.analysis is not None:
+            print(
+                format_report(
+                    report.analysis,
+                    title=report.title,
+                    notes=notes,
+                    sections=[list(section) for section in report.sections],
+                ),
+                end="",
+            )
     print(f"session file: {Path(runner.path)}")
     print(f"last hash: {runner.last_hash}")

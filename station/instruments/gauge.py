@@ -551,6 +551,17 @@ class ZeroResult:
     """The device value subtracted from later readings (0.0 for a device zero)."""
 
 
+class Subscription:
+    """A listener's hold on a :class:`GaugeSet`: :meth:`cancel` ends it (idempotent)."""
+
+    def __init__(self, cancel: Callable[[], None]) -> None:
+        self._cancel = cancel
+
+    def cancel(self) -> None:
+        """Stop hearing of sets and port changes."""
+        self._cancel()
+
+
 class GaugeSet:
     """The gauges of one station over one or more ports, captured together by trigger.
 
@@ -583,6 +594,11 @@ class GaugeSet:
         self.trigger = trigger
         self.on_reading = on_reading
         self.on_set = on_set
+        self.on_status = on_status
+        # Listeners added by subscribe(): each gets every set and port change, and leaves by
+        # cancelling its subscription (nobody swaps another's callback).
+        self._set_listeners: list[Callable[[CaptureResult], object]] = []
+        self._status_listeners: list[Callable[[PortStatus], object]] = []
         self.stable_k = stable_k
         self.stable_ms = stable_ms
         self.poll_interval = poll_interval
@@ -595,7 +611,7 @@ class GaugeSet:
                 unit=unit,
                 on_reading=self._on_reading,
                 on_rejection=on_rejection,
-                on_status=on_status,
+                on_status=self._on_status,
                 events=events,
                 backoff=backoff,
             )
@@ -651,6 +667,41 @@ class GaugeSet:
         """Each port's state, by URL."""
         return {reader.url: reader.state for reader in self.readers}
 
+    def subscribe(
+        self,
+        *,
+        on_set: Callable[[CaptureResult], object] | None = None,
+        on_status: Callable[[PortStatus], object] | None = None,
+    ) -> Subscription:
+        """Hear of every completed push set and every port change (on reader threads) until the
+        returned subscription is cancelled."""
+        with self._changed:
+            if on_set is not None:
+                self._set_listeners.append(on_set)
+            if on_status is not None:
+                self._status_listeners.append(on_status)
+
+        def cancel() -> None:
+            with self._changed:
+                if on_set is not None and on_set in self._set_listeners:
+                    self._set_listeners.remove(on_set)
+                if on_status is not None and on_status in self._status_listeners:
+                    self._status_listeners.remove(on_status)
+
+        return Subscription(cancel)
+
+    @property
+    def listeners(self) -> int:
+        """How many set and status listeners are subscribed now."""
+        with self._changed:
+            return len(self._set_listeners) + len(self._status_listeners)
+
+    def _on_status(self, status: PortStatus) -> None:
+        for listener in (self.on_status, *self._status_listeners):
+            error = _call_quietly(listener, status)
+            if error is not None:
+                raise error  # GaugeReader reports it as a status message
+
     # -- readings from the threads -------------------------------------------------------
 
     def _on_reading(self, reading: GaugeReading) -> None:
@@ -663,9 +714,10 @@ class GaugeSet:
                     completed = self._add_to_push_set(reading)
             self._changed.notify_all()
         if completed is not None:
-            error = _call_quietly(self.on_set, completed)
-            if error is not None:
-                self.readers[0].report(f"set callback failed: {error!r}")
+            for listener in (self.on_set, *self._set_listeners):
+                error = _call_quietly(listener, completed)
+                if error is not None:
+                    self.readers[0].report(f"set callback failed: {error!r}")
         error = _call_quietly(self.on_reading, reading)
         if error is not None:
             raise error  # GaugeReader reports it as a status message

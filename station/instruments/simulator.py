@@ -333,9 +333,9 @@ class Simulator:
                 parsed = self.protocol.parse(frame.rstrip(b"\r\n"))
                 if getattr(parsed, "device_channel", device) != device:
                     raise StationError(
-                        f"The {self.protocol.name} protocol carries one gauge per port: run one "
-                        "simulator per channel (e.g. --channels x), or use a multiplexed "
-                        "protocol such as mitutoyo."
+                        f"The {self.protocol.name} protocol carries one gauge per port (or use "
+                        "a multiplexed protocol such as mitutoyo)",
+                        remedy="split_channels",
                     )
 
     def _command_table(self, builder) -> dict[bytes, list[str]]:
@@ -373,7 +373,8 @@ class Simulator:
             if taken and not _is_pty_link(state.link_path):
                 raise StationError(
                     f"{state.link_path} exists and is not a simulator's link (a symlink to "
-                    "a pseudo-terminal): remove it or choose another --link path"
+                    "a pseudo-terminal): remove it",
+                    remedy="choose_link_path",
                 )
         self._link = state
         self._open_pty()

@@ -91,10 +91,10 @@ def _existing_ports_sentence() -> str:
     except Exception:  # listing is a courtesy in an error message; never mask the real error
         devices = []
     if devices:
-        return "Ports on this machine: " + ", ".join(devices) + " (see `station ports`)."
+        return "Ports on this machine: " + ", ".join(devices) + "."
     return (
         "This machine lists no serial ports: check the cable and the adaptor "
-        "(`station ports`, `dmesg | tail`)."
+        "(the kernel log, `dmesg | tail`, says whether it was seen)."
     )
 
 
@@ -141,8 +141,9 @@ def _open_error(url: str, error: BaseException) -> StationError:
         )
     if scheme == "hwgrep":
         return StationError(
-            f"No serial port matches {url}: plug the adaptor in, or check the VID:PID with "
-            f"`station ports`. {_existing_ports_sentence()}"
+            f"No serial port matches {url}: plug the adaptor in, or check the VID:PID. "
+            f"{_existing_ports_sentence()}",
+            remedy="list_ports",
         )
     if code == errno.ENOENT or "no such file" in lowered:
         return StationError(
@@ -185,8 +186,9 @@ def open_port(
 
     if not isinstance(url, str) or not url.strip():
         raise StationError(
-            "No port given: name the gauge's port, e.g. /dev/ttyUSB0 or rfc2217://HOST:PORT "
-            "(`station ports` lists the local ones)."
+            "No port given: name the gauge's port, e.g. /dev/ttyUSB0 or rfc2217://HOST:PORT",
+            remedy="list_ports",
+            field="port",
         )
     url = url.strip()
     settings = settings or SerialSettings()
@@ -199,8 +201,9 @@ def open_port(
         # Some kernels refuse 7 data bits or parity on a pseudo-terminal (EINVAL); a real
         # UART takes them.
         raise StationError(
-            f"{url} refused the line settings {settings.describe()} ({error.args[-1]}): check "
-            "--baud, --bytesize, --parity and --stopbits; a pseudo-terminal may only take 8N1."
+            f"{url} refused the line settings {settings.describe()} ({error.args[-1]}); a "
+            "pseudo-terminal may only take 8N1",
+            remedy="serial_settings",
         ) from error
     except (serial.SerialException, OSError, ValueError, TypeError) as error:
         raise _open_error(url, error) from error

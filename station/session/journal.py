@@ -128,7 +128,7 @@ class SessionWriter:
         """Create a new session file in ``folder`` and write its header (fsynced).
 
         ``header_fields`` must hold ``robot``, ``procedure`` (``id``, ``version``, ``sha256``),
-        ``channels`` and ``unit`` (``station.runner.SessionSetup.header_fields`` builds them);
+        ``channels`` and ``unit`` (``station.run.SessionSetup.header_fields`` builds them);
         ``format``, ``session``,
         ``created``, ``host`` and ``prev`` are filled in. The file is
         ``<date>T<time>Z_<robot>_<procedure>.jsonl`` (UTC; names sanitised), with ``-2``,
@@ -325,8 +325,9 @@ class SessionWriter:
                 "and start again"
             ) from None
         raise StationError(
-            f"{cause[0]}: nothing was lost up to {kept} in {self.path}; {cause[1]} and resume "
-            f"with `station capture --resume {self.path}`"
+            f"{cause[0]}: nothing was lost up to {kept} in {self.path}; {cause[1]}",
+            remedy="resume_session",
+            subject=str(self.path),
         ) from None
 
     def close(self) -> None:

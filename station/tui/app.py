@@ -1,7 +1,7 @@
 """StationApp: the terminal user interface that drives one procedure runner from set-up to verdict.
 
 The app owns the long-lived things: the sessions folder, the procedure catalogue, the open
-instruments and the :class:`~station.runner.Runner`. Screens ask the app to start, resume or end a
+instruments and the :class:`~station.run.Runner`. Screens ask the app to start, resume or end a
 session and receive the runner's state to draw. The runner's listener runs on whatever thread
 wrote the event; it only stores the newest state and posts a coalescing :class:`RunnerChanged`, and
 the app redraws at most ``REDRAW_INTERVAL`` apart on the UI thread (a burst of readings costs one
@@ -18,7 +18,6 @@ analysis) load when first needed, so the first screen appears fast.
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import signal
 import threading
 import time
@@ -32,10 +31,11 @@ from textual.binding import Binding
 
 from station.errors import StationError
 from station.tui.messages import RunnerChanged
+from station.tui.remedies import shown
 
 if TYPE_CHECKING:
     from station.procedures import ProcedureCatalog
-    from station.runner import Runner, RunnerNotice, RunnerState, SessionSetup
+    from station.run import Runner, RunnerNotice, RunnerState, SessionSetup
 
 REDRAW_INTERVAL = 0.1
 """Seconds between two redraws of the live screens: at most ~10 a second, whatever the rate."""
@@ -100,6 +100,8 @@ class StationApp(App[int]):
         self.gauges: Any = None
         self._catalog: ProcedureCatalog | None = None
         self._latest_state: RunnerState | None = None
+        self._latest_analysis: Any = None
+        self._latest_result: Any = None
         self._state_lock = threading.Lock()
         self._last_redraw = 0.0
         self._redraw_pending = False
@@ -157,7 +159,7 @@ class StationApp(App[int]):
             try:
                 runner.interrupt(reason)
             except StationError as error:
-                self.notify(error.message, severity="error")
+                self.notify(shown(error), severity="error")
         self.close_instruments()
 
     def close_instruments(self) -> None:
@@ -217,7 +219,7 @@ class StationApp(App[int]):
 
     def start_session(self, setup: SessionSetup) -> None:
         """Open the instruments and start a new session; raises StationError with a sentence."""
-        from station.runner import Runner
+        from station.run import Runner
 
         self.warm_up_analysis()
         self._find_demo_fixture(setup)
@@ -235,7 +237,7 @@ class StationApp(App[int]):
     def _open_instruments(self, setup: SessionSetup) -> None:
         """Open the gauges and wait for the line, so a wrong port is refused before a session
         file exists (PortNotOpen with the reader's own sentence)."""
-        from station.runner import open_gauges
+        from station.run import open_gauges
 
         self.close_instruments()
         self.gauges = open_gauges(setup)
@@ -254,7 +256,7 @@ class StationApp(App[int]):
     def resume_session(self, path: Path, ports: Any) -> None:
         """Reopen the instruments (``ports``: the line as the set-up screen now says) and
         continue an unfinished session file."""
-        from station.runner import Runner, resume_setup
+        from station.run import Runner, resume_setup
 
         setup = resume_setup(path, procedures_dirs=self.config.procedure_dirs, ports=ports)
         self.warm_up_analysis()
@@ -275,17 +277,7 @@ class StationApp(App[int]):
         runner = self.runner
         if runner is None:
             return
-        state = runner.state()
-        if (
-            state.current is not None
-            and state.current.kind == "cycles"
-            and state.cycle >= state.cycles_min
-        ):
-            runner.confirm()
-        elif state.current is not None and state.current.kind == "stroke" and state.strokes:
-            # Below the step's minimum the runner refuses; the session then ends incomplete.
-            with contextlib.suppress(StationError):
-                runner.confirm()
+        # The engine closes the current step where it has its minimum, then finishes.
         analysis = runner.finish()
         state = runner.state()
         self.close_instruments()
@@ -302,6 +294,9 @@ class StationApp(App[int]):
         """Called on the thread that produced the event: store the state, post a message."""
         with self._state_lock:
             self._latest_state = notice.state
+            if notice.analysis is not None:
+                self._latest_analysis = notice.analysis
+                self._latest_result = notice.result
         fixture = self.demo_fixture
         if fixture is not None:
             # The simulated robot goes where the procedure says (its pendant follows).
@@ -352,13 +347,15 @@ class StationApp(App[int]):
         return state
 
     def live_analysis(self) -> Any:
-        """The runner's live analysis, or None before the first accepted cycle."""
-        if self.runner is None:
-            return None
-        try:
-            return self.runner.analysis()
-        except StationError:
-            return None
+        """The newest live analysis the engine's notices carried, or None before there is
+        one (the UI never takes the engine's lock for it)."""
+        with self._state_lock:
+            return self._latest_analysis
+
+    def live_result(self) -> Any:
+        """The analysis kind's own live result (per-stroke straightness...), or None."""
+        with self._state_lock:
+            return self._latest_result
 
     def _show_runner_screen(self, state: RunnerState) -> bool:
         """Put up the checklist or the dashboard for the current step; True when it switched."""
@@ -368,14 +365,17 @@ class StationApp(App[int]):
         if state.status in ("finished", "interrupted", "failed"):
             return False
         screen = self.screen
-        if state.current is not None and state.current.kind == "stroke":
+        action = state.action.kind
+        if action == "stream":
             from station.tui.screens.strokes import StrokeDashboardScreen
 
             if not isinstance(screen, StrokeDashboardScreen):
                 self._replace_run_screen(StrokeDashboardScreen())
                 return True
             return False
-        wants_dashboard = state.current is None or state.current.kind in ("capture", "cycles")
+        # Capturing and finishing happen on the dashboard; confirm, input and zero on the
+        # checklist.
+        wants_dashboard = action in ("capture", "finish", "done")
         if wants_dashboard and not isinstance(screen, DashboardScreen):
             self._replace_run_screen(DashboardScreen(live=True))
             return True
@@ -399,6 +399,8 @@ class StationApp(App[int]):
         self.runner = None
         with self._state_lock:
             self._latest_state = None
+            self._latest_analysis = None
+            self._latest_result = None
         while len(self.screen_stack) > 2:
             self.pop_screen()
         self.switch_screen(HomeScreen())

@@ -59,7 +59,7 @@ async def run_autopilot(app: StationApp) -> None:
             state = app.current_state()
             if state is None or screen.streaming or state.status != "running":
                 continue
-            if state.strokes >= state.strokes_target:
+            if state.progress is not None and state.progress.complete:
                 screen.action_finish()
             else:
                 screen.action_stream()
@@ -76,10 +76,11 @@ async def run_autopilot(app: StationApp) -> None:
             ):
                 rejected = True
                 screen.action_reject(REJECT_REASON)
-            elif not state.can_capture:
-                if state.complete:
-                    screen.action_finish()
-            elif state.current.kind == "capture" or state.cycle < state.cycles_target:
+            elif state.action.kind == "finish":
+                screen.action_finish()
+            elif state.action.kind != "capture" or state.status != "running":
+                continue
+            elif state.progress is None or not state.progress.complete:
                 screen.action_capture()
             else:
                 screen.action_finish()

@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 from station.procedures import discover_procedures
-from station.runner import PortSetup, SessionSetup
+from station.run import PortSetup, SessionSetup
 from station.session.journal import SessionWriter
 from station.session.model import decode_line, encode_line, load_session
 

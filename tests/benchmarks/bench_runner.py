@@ -21,7 +21,7 @@ from pathlib import Path
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import AxisModel, GaugeSpec, Simulator, fixture_model
 from station.procedures import parse_procedure
-from station.runner import PortSetup, Runner, RunnerNotice, SessionSetup, open_gauges
+from station.run import PortSetup, Runner, RunnerNotice, SessionSetup, open_gauges
 from station.session.journal import SessionWriter
 
 PROCEDURE = b"""

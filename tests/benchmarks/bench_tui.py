@@ -128,7 +128,7 @@ async def bench_latency(rate: float, seconds: float) -> dict[str, float]:
     from station.instruments.protocols import get_protocol
     from station.instruments.simulator import AxisModel, FixtureModel, GaugeSpec, Simulator
     from station.procedures import discover_procedures
-    from station.runner import PortSetup, SessionSetup
+    from station.run import PortSetup, SessionSetup
     from station.tui.app import StationApp, StationConfig
     from station.tui.screens.dashboard import DashboardScreen
 

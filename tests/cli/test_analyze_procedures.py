@@ -155,7 +155,7 @@ def test_bad_tolerance_is_a_one_line_error(linearity_csv, args, fault):
 def write_session(folder: Path, procedure_id: str, events: list[tuple[str, dict]]) -> Path:
     """A real, hash-chained session file of the built-in procedure ``procedure_id``."""
     from station.procedures import builtin_procedures_dir, load_procedure
-    from station.runner import PortSetup, SessionSetup
+    from station.run import PortSetup, SessionSetup
     from station.session.journal import SessionWriter
 
     procedure = load_procedure(builtin_procedures_dir() / f"{procedure_id}.toml")
@@ -249,7 +249,7 @@ def test_a_site_procedure_is_analysed_by_its_declared_kind(tmp_path, monkeypatch
     """Review finding 17: a site's `relative_accuracy_site` was analysed as repeatability
     because analyze chose the analysis by the procedure's id."""
     from station.procedures import builtin_procedures_dir, load_procedure
-    from station.runner import PortSetup, SessionSetup
+    from station.run import PortSetup, SessionSetup
     from station.session.journal import SessionWriter
 
     site = tmp_path / "site"

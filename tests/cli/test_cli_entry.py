@@ -23,7 +23,8 @@ def test_a_command_imports_no_other_command_module():
     probe = (
         "import sys; from station.cli import main; "
         "code = main(['procedures']); "
-        "loaded = sorted(m for m in sys.modules if m.startswith('station.commands.')); "
+        "loaded = sorted(m for m in sys.modules if m.startswith('station.commands.') "
+        "and not m.rsplit('.', 1)[-1].startswith('_')); "
         "print(code, loaded)"
     )
     result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)

@@ -13,7 +13,7 @@ import pytest
 
 from station.cli import main
 from station.procedures import discover_procedures
-from station.runner import PortSetup, SessionSetup
+from station.run import PortSetup, SessionSetup
 from station.session.journal import SessionWriter
 
 

@@ -16,7 +16,7 @@ import pytest
 
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import AxisModel, GaugeSpec, Simulator, fixture_model
-from station.runner import format_value
+from station.run import format_value
 from station.session.model import Session
 
 REPO = Path(__file__).resolve().parents[2]

@@ -200,7 +200,7 @@ def test_gauges_in_another_unit_are_refused_before_the_session(procedures, tmp_p
      ["--resolution", "0.001"], ["--placements", "2"], ["--strokes", "3"]],
 )  # fmt: skip
 def test_resume_refuses_setup_options(tmp_path, options):
-    from station.runner import PortSetup, SessionSetup
+    from station.run import PortSetup, SessionSetup
     from station.session.journal import SessionWriter
 
     from .conftest import DEVICE_MAP, repeatability
@@ -225,7 +225,7 @@ def test_resume_refuses_setup_options(tmp_path, options):
 
 def test_resume_accepts_the_same_setup_again(tmp_path):
     """A script may repeat its command line with --resume: equal values are not a change."""
-    from station.runner import PortSetup, SessionSetup
+    from station.run import PortSetup, SessionSetup
     from station.session.journal import SessionWriter
 
     from .conftest import DEVICE_MAP, repeatability
@@ -252,7 +252,7 @@ def test_resume_accepts_the_same_setup_again(tmp_path):
 
 CRASHING = """
 import sys
-import station.runner as runner
+import station.run.engine as runner
 
 original = runner.Runner.capture
 calls = []

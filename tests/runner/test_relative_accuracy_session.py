@@ -16,7 +16,7 @@ import pytest
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import GaugeSpec, Simulator, TwoFixtureModel
 from station.procedures import discover_procedures
-from station.runner import PortSetup, Runner, SessionSetup
+from station.run import PortSetup, Runner, SessionSetup
 from station.session.model import load_session
 
 STATION = [sys.executable, "-m", "station"]

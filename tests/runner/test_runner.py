@@ -15,7 +15,8 @@ from station.analysis.summary import analyze, to_json
 from station.errors import StationError
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import Faults, GaugeSpec, Simulator, fixture_model
-from station.runner import PortSetup, Runner, RunnerNotice, SessionSetup, analysis_config
+from station.run import PortSetup, Runner, RunnerNotice, SessionSetup
+from station.session.header import analysis_config
 from station.session.model import load_session
 from station.session.verify import verify_session
 
@@ -81,13 +82,16 @@ def test_repeatability_walk_poll(simulator, gauges_for, tmp_path):
     runner.confirm()  # a zero step's confirm zeroes
     runner.confirm()  # teach B
     state = runner.state()
-    assert state.current.kind == "cycles" and (state.cycle, state.cycles_target) == (0, 30)
+    assert state.current.kind == "cycles" and (state.progress.done, state.progress.target) == (
+        0,
+        30,
+    )
     assert "Cycle 1 of 30" in runner.prompt()
 
     with pytest.raises(StationError, match="capture at least 25 more"):
         runner.confirm()
     outcomes = []
-    while runner.state().cycle < 30:
+    while runner.state().progress.done < 30:
         outcome = runner.capture(3.0)
         assert outcome.recorded, outcome.message
         outcomes.append(outcome)
@@ -100,7 +104,7 @@ def test_repeatability_walk_poll(simulator, gauges_for, tmp_path):
                 runner.capture(1.0)
             runner.resume_capture()
     state = runner.state()
-    assert state.cycle == 30 and state.accepted == 30 and len(state.cycles) == 31
+    assert state.progress.done == 30 and state.accepted == 30 and len(state.cycles) == 31
     assert [c.cycle for c in state.cycles if c.rejected] == [12]
     # The live analysis already equals the batch analysis of what is on disk.
     assert to_json(runner.analysis()) == to_json(batch_analysis(runner.path))
@@ -177,7 +181,7 @@ def test_every_step_kind_and_resume(simulator, gauges_for, tmp_path):
 
     resumed = Runner.resume(runner.path, gauges, setup=setup)
     state = resumed.state()
-    assert state.current.id == "cycles" and state.cycle == 1
+    assert state.current.id == "cycles" and state.progress.done == 1
     assert [v.mark for v in state.steps].count("done") == 7
     outcome = resumed.capture(3.0)
     assert outcome.cycle.cycle == 4  # numbering continues
@@ -300,67 +304,10 @@ def test_push_trigger_records_sets_without_capture_calls(gauges_for, tmp_path):
 def test_runner_imports_no_ui():
     """The runner is domain code: importing it (and the capture command) loads no UI."""
     code = (
-        "import sys, station.runner, station.commands.capture\n"
+        "import sys, station.run, station.verdicts, station.commands.capture\n"
         "ui = [m for m in sys.modules if m.split('.')[0] in ('textual', 'plotext')"
         " or m.startswith('station.tui')]\n"
         "print(ui)"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0 and done.stdout.strip() == "[]", done.stdout + done.stderr
-
-
-def test_stroke_streams_points_in_batches(gauges_for, tmp_path):
-    model = fixture_model(("h", "v", "s"), gauge=GaugeSpec(resolution=0.001, unit="mm"))
-    sim = Simulator(get_protocol("mitutoyo"), model, seed=5)
-    sim.start_pty()
-    try:
-        procedure = strokes_procedure(tmp_path)
-        setup = SessionSetup(
-            procedure=procedure,
-            robot="KSC-7",
-            operator="tester",
-            ports=(PortSetup(sim.url, "mitutoyo", {"1": "h", "2": "v", "3": "s"}),),
-        )
-        gauges = gauges_for(setup)
-        runner = Runner.start(setup, gauges, tmp_path / "s")
-        with pytest.raises(StationError, match="only 0 of 2 strokes"):
-            runner.confirm()
-        outcomes = []
-        for index in range(2):
-            if index == 1:
-                # Interrupted between strokes: the resumed session knows stroke 1 is done.
-                runner.interrupt("SIGHUP")
-                runner = Runner.resume(runner.path, gauges, setup=setup)
-                assert runner.state().strokes == 1
-            worker = threading.Thread(
-                target=lambda current=runner: outcomes.append(current.stroke(1.0, batch_points=10))
-            )
-            worker.start()
-            # However slow the machine, the stroke ends only once it has its 30 points.
-            deadline = time.monotonic() + 120
-            while runner.state().stroke_points < 30 and time.monotonic() < deadline:
-                assert worker.is_alive(), outcomes
-                time.sleep(0.01)
-            assert runner.state().stroke_points >= 30, "30 points did not arrive in 120 s"
-            runner.end_stroke()
-            worker.join(30)
-            assert not worker.is_alive()
-        assert [o.stroke for o in outcomes] == [1, 2]
-        assert runner.state().strokes == 2 and runner.state().strokes_target == 2
-        runner.confirm()
-        runner.finish()
-        session = load_session(runner.path, recover=False)
-        assert {batch.stroke for batch in session.samples} == {1, 2}
-        assert len(session.samples) >= 6  # streamed in fsynced batches of at most 10 points
-        assert all(len(b.values) <= 10 for b in session.samples)
-        for outcome in outcomes:
-            rows = [b for b in session.samples if b.stroke == outcome.stroke]
-            assert sum(len(b.values) for b in rows) == outcome.points >= 30
-            assert all(b.channels == ("h", "v", "s") for b in rows)
-        # The points are the simulator's values, in the order it sent them.
-        first = session.samples[0].as_arrays()["s"]
-        sent = sim.sent_values("s")
-        assert list(first) == pytest.approx(sent[: len(first)], abs=1e-12)
-        assert verify_session(runner.path).ok
-    finally:
-        sim.stop()

@@ -9,7 +9,7 @@ import pytest
 
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import AxisModel, GaugeSpec, Simulator, fixture_model
-from station.runner import Runner, open_gauges
+from station.run import Runner, open_gauges
 from station.session.model import load_session
 
 from .conftest import CHANNELS, every_kind_procedure, setup_for
@@ -73,19 +73,19 @@ def test_resume_on_fresh_gauges_keeps_the_software_zero(biased, gauges_for, tmp_
 
 
 def test_resumes_on_the_same_gauges_do_not_chain_callbacks(biased, gauges_for, tmp_path):
-    """Finding 18: every resume on one gauge set used to wrap the status callback again."""
+    """Finding 18: every resume on one gauge set used to wrap the status callback again; now
+    each engine holds a subscription while its file is open and cancels it on close."""
     setup = setup_for(biased.url, every_kind_procedure(tmp_path), cycles=4)
     gauges = gauges_for(setup)
-    reader = gauges.readers[0]
-    original = reader.on_status
     runner = Runner.start(setup, gauges, tmp_path / "sessions")
+    assert gauges.listeners == 1  # port changes (poll: no set listener)
     runner.close()
-    assert reader.on_status is original
+    assert gauges.listeners == 0
     for _ in range(3):
         resumed = Runner.resume(runner.path, gauges, setup=setup)
-        assert reader.on_status is not original  # hooked while open
+        assert gauges.listeners == 1  # subscribed while open
         resumed.close()
-        assert reader.on_status is original
+        assert gauges.listeners == 0
 
 
 class Stop(BaseException):

@@ -15,16 +15,16 @@ import pytest
 
 from station.errors import StationError
 from station.procedures import parse_procedure
-from station.runner import (
+from station.run import (
     PortSetup,
     Runner,
     RunnerNotice,
     SessionSetup,
-    analysis_config,
     format_value,
     open_gauges,
     setup_from_header,
 )
+from station.session.header import analysis_config
 from station.session.model import load_session
 
 from .conftest import DEVICE_MAP, cycles_only_procedure, make_simulator, setup_for

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from station.procedures import discover_procedures
-from station.runner import PortSetup, SessionSetup
+from station.run import PortSetup, SessionSetup
 from station.session.journal import SessionWriter
 
 CHANNELS = ("x", "y", "z")

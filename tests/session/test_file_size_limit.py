@@ -19,6 +19,7 @@ CHILD = textwrap.dedent(
     import resource, sys
     sys.path.insert(0, sys.argv[2])
     from child_helpers import header, reading
+    from station.commands._remedies import CLI_REMEDIES
     from station.errors import StationError
     from station.session.journal import SessionWriter
 
@@ -35,7 +36,7 @@ CHILD = textwrap.dedent(
             event = writer.append("reading", **reading(cycle))
             print("ack", event["seq"], cycle, flush=True)
     except StationError as error:
-        print("error", error.message, flush=True)
+        print("error", error.worded(CLI_REMEDIES), flush=True)
         sys.exit(3)
     """
 )
@@ -43,7 +44,7 @@ CHILD = textwrap.dedent(
 HELPER = textwrap.dedent(
     """
     from station.procedures import discover_procedures
-    from station.runner import PortSetup, SessionSetup
+    from station.run import PortSetup, SessionSetup
 
     def header():
         procedure = discover_procedures(use_env=False).get("repeatability")
@@ -80,7 +81,7 @@ def test_the_file_size_limit_is_a_clear_error_and_nothing_acknowledged_is_lost(
     assert len(acknowledged) > 10
     assert error.startswith("error the file-size limit was reached")
     assert f"nothing was lost up to cycle {cycles[-1]}" in error
-    assert "station capture --resume" in error
+    assert "station capture --resume" in error  # the command line's wording of the remedy
     assert path.stat().st_size <= limit
 
     session = load_session(path)

@@ -10,10 +10,10 @@ import pytest
 from station.errors import StationError
 from station.instruments.simulator import TwoFixtureModel
 from station.procedures import discover_procedures
-from station.runner import PortSetup, SessionSetup
+from station.run import PortSetup, SessionSetup
 from station.session.journal import SessionWriter
 from station.session.model import load_session
-from station.session.report import analyze_session, analyze_session_file
+from station.verdicts import analyze_session, analyze_session_file
 
 
 def write_procedure_session(

@@ -82,9 +82,9 @@ async def test_full_repeatability_session(tmp_path: Path, fixture_pty, tui) -> N
         assert isinstance(dashboard, DashboardScreen)
 
         # 30 accepted cycles, with cycle 5 rejected for a reason on the way.
-        while app.runner.state().cycle < 30:
+        while app.runner.state().progress.done < 30:
             await tui.capture_one(pilot)
-            if len(app.runner.state().cycles) == 5 and app.runner.state().cycle == 5:
+            if len(app.runner.state().cycles) == 5 and app.runner.state().progress.done == 5:
                 await pilot.press("r")
                 await pilot.pause()
                 await pilot.press(*REASON)

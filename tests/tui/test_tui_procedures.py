@@ -193,7 +193,7 @@ async def test_linearity_through_the_tui(tmp_path: Path, lab: DemoLab, tui) -> N
         await tui.wait_until(pilot, lambda: "points now" in text_of(app, "#dash-title"))
         await tui.wait_until(
             pilot,
-            lambda: app.runner.state().strokes >= 3 and not dashboard.streaming,
+            lambda: app.runner.state().progress.done >= 3 and not dashboard.streaming,
             timeout=60,
         )
         # 200 sets a second arrive, each a runner notice: the screen is redrawn at most once
@@ -252,7 +252,7 @@ async def test_a_linearity_session_left_and_resumed_goes_on_from_its_strokes(
                 pilot, lambda before=before: app.runner.state().current.index != before
             )
         await tui.wait_until(pilot, lambda: isinstance(app.screen, StrokeDashboardScreen))
-        await tui.wait_until(pilot, lambda: app.runner.state().strokes >= 2, timeout=60)
+        await tui.wait_until(pilot, lambda: app.runner.state().progress.done >= 2, timeout=60)
         # What Leave does once confirmed: the session is kept, interrupted.
         app.interrupt_session("operator left")
         app.go_home()
@@ -269,7 +269,7 @@ async def test_a_linearity_session_left_and_resumed_goes_on_from_its_strokes(
         assert len(dashboard.result.strokes) >= 2
         await tui.wait_until(
             pilot,
-            lambda: app.runner.state().strokes >= 4 and not dashboard.streaming,
+            lambda: app.runner.state().progress.done >= 4 and not dashboard.streaming,
             timeout=60,
         )
         await tui.wait_until(pilot, lambda: len(dashboard.result.strokes) == 4)

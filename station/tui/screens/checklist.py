@@ -19,14 +19,15 @@ from textual.screen import Screen
 from textual.widgets import Footer, Input, Label, Static
 
 from station.errors import StationError
+from station.tui.remedies import shown
 from station.tui.widgets.step_list import StepList
 
 if TYPE_CHECKING:
-    from station.runner import RunnerState, StepView
+    from station.run import Action, RunnerState, StepView
     from station.tui.app import StationApp
 
 ENTER_DOES = {
-    "check": "Press Enter when this is done.",
+    "confirm": "Press Enter when this is done.",
     "zero": "Keep the robot still, then press Enter to zero the indicators.",
     "input": "Type the values, then press Enter to save them.",
 }
@@ -80,13 +81,15 @@ class ChecklistScreen(Screen[None]):
         key = (current.index, current.id) if current is not None else None
         if key != self._shown_step:
             self._shown_step = key
-            self._show_step(current, state.placements)
+            self._show_step(current, state.placements, state.action)
         message = state.messages[-1] if state.messages else None
         if message is not None:
             style = {"error": "bold red", "warning": "yellow"}.get(message.level, "green")
             self.query_one("#step-message", Static).update(Text(message.text, style=style))
 
-    def _show_step(self, view: StepView | None, placements: int | None = None) -> None:
+    def _show_step(
+        self, view: StepView | None, placements: int | None = None, todo: Action | None = None
+    ) -> None:
         inputs = self.query_one("#step-inputs", Vertical)
         inputs.remove_children()
         if view is None:
@@ -103,19 +106,20 @@ class ChecklistScreen(Screen[None]):
             Text(f"Step {view.index + 1}: {step.title}{placement}", style="bold")
         )
         text = Text(" ".join(step.text.split()))
-        pendant = self._demo_pendant(view) if step.kind == "input" else None
+        asks = todo.kind if todo is not None else "confirm"
+        pendant = self._demo_pendant(view) if asks == "input" else None
         if pendant is not None:
             text.append("\n\nTeach pendant (simulated): ", style="bold")
             text.append(pendant, style="bold reverse")
         self.query_one("#step-text", Static).update(text)
-        action = ENTER_DOES.get(step.kind, "Press Enter to continue.")
-        if self.app.config.demo is not None and step.kind == "input":
+        action = ENTER_DOES.get(asks, "Press Enter to continue.")
+        if self.app.config.demo is not None and asks == "input":
             action += " (Demo: copy the simulated pendant's X, Y, Z shown above.)"
         elif self.app.config.demo is not None:
             action += " (Demo: the robot and the gauges are simulated; just press Enter.)"
         self.query_one("#step-action", Static).update(Text(action, style="bold cyan"))
-        if step.kind == "input":
-            for field in step.fields:
+        if todo is not None and todo.kind == "input":
+            for field in todo.fields:
                 unit = f" ({field.unit})" if field.unit else ""
                 row = Horizontal(
                     Label(f"{field.label}{unit}", classes="field-label"),
@@ -160,7 +164,7 @@ class ChecklistScreen(Screen[None]):
         state = self.app.current_state()
         if runner is None or state is None or state.current is None or self.busy:
             return
-        kind = state.current.kind
+        kind = state.action.kind
         if kind == "input":
             values = {
                 str(widget.id).removeprefix("input-"): str(widget.value)  # type: ignore[attr-defined]
@@ -183,7 +187,7 @@ class ChecklistScreen(Screen[None]):
         try:
             call()
         except StationError as error:
-            self.app.call_from_thread(self._refused, error.message)
+            self.app.call_from_thread(self._refused, shown(error))
         finally:
             self.app.call_from_thread(self._done)
 

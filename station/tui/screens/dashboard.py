@@ -31,7 +31,7 @@ from station.tui.widgets.instrument_status import InstrumentStatus
 from station.tui.widgets.stats_panel import StatsPanel, StatsRows
 
 if TYPE_CHECKING:
-    from station.runner import RunnerState
+    from station.run import RunnerState
     from station.tui.app import StationApp
 
 
@@ -66,19 +66,18 @@ class DashboardView:
         accepted = [record for record in state.cycles if record.rejected is None]
         last_cycle = state.last_cycle
         current = state.current
-        kind = current.kind if current is not None else None
+        counted = state.progress
         rejected = len(state.cycles) - len(accepted)
-        if kind == "cycles":
-            ready = state.cycle >= state.cycles_target
-            progress = f"cycle {state.cycle} of {state.cycles_target}"
-            if state.cycle < state.cycles_min:
-                progress += f" (at least {state.cycles_min})"
-            prompt = current.step.prompt_for(state.cycle + 1, state.cycles_target)
-            prompt = (prompt or current.step.title) + "  Press Space to capture."
-        elif kind == "capture":
+        if state.action.kind == "capture" and counted is not None:
+            ready = counted.complete
+            progress = f"{counted.noun} {counted.done} of {counted.target}"
+            if not counted.enough:
+                progress += f" (at least {counted.minimum})"
+            prompt = (state.action.prompt or current.step.title) + "  Press Space to capture."
+        elif state.action.kind == "capture":
             ready = False
             progress = f"{len(accepted)} captured"
-            prompt = f"{current.step.title}: {' '.join(current.step.text.split())}"
+            prompt = f"{current.step.title}: {' '.join(state.action.prompt.split())}"
             prompt = prompt.rstrip() + "  Press Space to capture."
         else:
             ready = True
@@ -354,7 +353,8 @@ class DashboardScreen(Screen[None]):
         state = self.app.current_state()
         if not self.live or state is None or self.capturing:
             return
-        if state.cycle < state.cycles_min and not force:
+        counted = state.progress
+        if counted is not None and not counted.enough and not force:
             from station.tui.screens.dialogs import ConfirmScreen
 
             def finish(sure: bool | None) -> None:
@@ -363,8 +363,8 @@ class DashboardScreen(Screen[None]):
 
             self.app.push_screen(
                 ConfirmScreen(
-                    f"Finish with {state.cycle} cycles?",
-                    f"The report asks for {state.cycles_min} to {state.cycles_target}; the "
+                    f"Finish with {counted.done} {counted.noun}s?",
+                    f"The report asks for {counted.minimum} to {counted.target}; the "
                     "verdict is weaker with fewer.",
                 ),
                 callback=finish,

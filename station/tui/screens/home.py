@@ -17,6 +17,8 @@ from textual.screen import Screen
 from textual.widgets import Footer, OptionList, Static
 from textual.widgets.option_list import Option
 
+from station.tui.remedies import shown
+
 if TYPE_CHECKING:
     from station.tui.app import StationApp
 
@@ -78,7 +80,7 @@ class HomeScreen(Screen[None]):
             self._session_count = len(list_sessions(config.sessions_dir))
         except StationError as error:
             self._unfinished, self._session_count = [], 0
-            self._load_error = error.message
+            self._load_error = shown(error)
         choices = self.query_one("#home-choices", OptionList)
         choices.clear_options()
         for index, summary in enumerate(self._unfinished):

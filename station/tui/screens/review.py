@@ -11,6 +11,7 @@ from textual.screen import Screen
 from textual.widgets import DataTable, Footer, Static
 
 from station.errors import StationError
+from station.tui.remedies import shown
 
 if TYPE_CHECKING:
     from station.tui.app import StationApp
@@ -88,7 +89,7 @@ class ReviewScreen(Screen[None]):
         try:
             view = SummaryView.from_file(summary.path)
         except StationError as error:
-            self.notify(error.message, severity="error")
+            self.notify(shown(error), severity="error")
             return
         self.app.push_screen(SummaryScreen(view, reviewing=True))
 

@@ -1,7 +1,7 @@
 """The set-up screen: who, what, the limits, the port; a live "test connection"; then start.
 
 Every field is checked when the operator starts, and a refused value gets a sentence right under
-its field (the runner's :class:`~station.runner.SessionSetup` and the analysis'
+its field (the runner's :class:`~station.run.SessionSetup` and the analysis'
 :class:`~station.analysis.capability.SpecLimits` do the checking; this screen only turns the
 typed text into their arguments). When resuming, the recorded set-up is shown and only the
 instrument line can change (the port may have moved).
@@ -27,6 +27,7 @@ from textual.widgets import Button, Footer, Input, Label, Select, Static
 from station.errors import StationError
 from station.tui.app import PortNotOpen
 from station.tui.messages import ConnectionTested
+from station.tui.remedies import shown
 from station.tui.widgets.fields import say
 
 if TYPE_CHECKING:
@@ -433,7 +434,7 @@ class SetupScreen(Screen[None]):
     def read_ports(self, errors: dict[str, str]) -> tuple[Any, ...]:
         """The instrument line as the runner's ``PortSetup``; faults go into ``errors``."""
         from station.instruments.protocols import get_protocol
-        from station.runner import PortSetup
+        from station.run import PortSetup
 
         url = self._value("port")
         if not url:
@@ -441,12 +442,12 @@ class SetupScreen(Screen[None]):
         try:
             protocol = get_protocol(self._value("protocol"))
         except StationError as error:
-            errors["protocol"] = error.message
+            errors["protocol"] = shown(error)
             protocol = None
         try:
             channel_map = parse_channel_map(self._value("map"))
         except StationError as error:
-            errors["map"] = error.message
+            errors["map"] = shown(error)
             channel_map = {}
         if errors.keys() & {"port", "protocol", "map"} or protocol is None:
             return ()
@@ -462,7 +463,7 @@ class SetupScreen(Screen[None]):
     def read_setup(self) -> Any | None:
         """A validated ``SessionSetup``, or None after putting each fault next to its field."""
         from station.analysis.capability import SpecLimits
-        from station.runner import SessionSetup
+        from station.run import SessionSetup
 
         self._clear_errors()
         errors: dict[str, str] = {}
@@ -489,7 +490,7 @@ class SetupScreen(Screen[None]):
                     )
                 limits[channel] = SpecLimits(lsl=typed.lsl, usl=typed.usl, nominal=typed.nominal)
             except StationError as error:
-                errors[f"limits-{channel}"] = error.message
+                errors[f"limits-{channel}"] = shown(error)
         count = count_field(procedure)
         cycles: int | None = None
         try:
@@ -515,7 +516,7 @@ class SetupScreen(Screen[None]):
                 **{count.setup_key: cycles},
             )
         except StationError as error:
-            self._say("setup", error.message)
+            self._say("setup", shown(error))
             return None
 
     # -- actions --------------------------------------------------------------------------
@@ -532,9 +533,9 @@ class SetupScreen(Screen[None]):
             try:
                 self.app.resume_session(self.resume_path, ports)
             except PortNotOpen as error:
-                self._refuse({"port": error.message})
+                self._refuse({"port": shown(error)})
             except StationError as error:
-                self._say("setup", error.message)
+                self._say("setup", shown(error))
             return
         setup = self.read_setup()
         if setup is None:
@@ -542,9 +543,9 @@ class SetupScreen(Screen[None]):
         try:
             self.app.start_session(setup)
         except PortNotOpen as error:
-            self._refuse({"port": error.message})
+            self._refuse({"port": shown(error)})
         except StationError as error:
-            self._say("setup", error.message)
+            self._say("setup", shown(error))
 
     def action_test_connection(self) -> None:
         """Open the port and show a few readings; nothing is recorded."""
@@ -572,7 +573,7 @@ class SetupScreen(Screen[None]):
                 self.post_message(ConnectionTested(lines=lines))
             self.post_message(ConnectionTested(done=True))
         except StationError as error:
-            self.post_message(ConnectionTested(error=error.message, done=True))
+            self.post_message(ConnectionTested(error=shown(error), done=True))
 
     def on_connection_tested(self, message: ConnectionTested) -> None:
         """Show the readings (or why there are none)."""

@@ -1,6 +1,6 @@
 """The linearity dashboard: the robot shuttles along the bar while h, v and s stream.
 
-A thread worker runs the runner's :meth:`~station.runner.Runner.stream_strokes`, which records
+A thread worker runs the runner's :meth:`~station.run.Runner.stream_strokes`, which records
 every point and splits the strokes by the scale's travel; each whole stroke comes back (its
 points on disk) and is analysed there, off the UI thread, with the same
 :func:`~station.analysis.linearity.analyze_linearity` as ``station analyze``. The screen shows,
@@ -28,6 +28,7 @@ from textual.screen import Screen
 from textual.widgets import Footer, Static
 
 from station.errors import StationError
+from station.tui.remedies import shown
 from station.tui.widgets.alarm_log import AlarmLog, alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.deviation_plot import DeviationData, DeviationPlot, trace
@@ -36,22 +37,13 @@ from station.tui.widgets.instrument_status import InstrumentStatus
 from station.tui.widgets.stats_panel import StatsPanel, StatsRows
 
 if TYPE_CHECKING:
-    from station.runner import RunnerState
+    from station.run import RunnerState
     from station.tui.app import StationApp
 
 EARLIER_SHOWN = 8
 """Earlier strokes drawn under the newest (more only blur the plot)."""
 STREAM_TIMEOUT = 1.0
 """Seconds the stream waits for a reading set before it looks at the stop signal again."""
-
-
-@dataclass
-class StrokeAnalysed(Message):
-    """A whole stroke is on disk and the strokes so far are analysed (``result``: a
-    ``LinearityAnalysis``), or the analysis could not be made (``error``)."""
-
-    result: Any = None
-    error: str = ""
 
 
 @dataclass
@@ -180,9 +172,15 @@ class StrokeDashboardScreen(Screen[None]):
         from station.tui.screens.dashboard import session_title
 
         title = Text(session_title(header), style="bold")
-        progress = f"   {state.strokes} of {state.strokes_target} strokes done"
-        if self.streaming:
-            progress += f" · {state.stroke_points} points now"
+        counted = state.progress
+        done, target = (counted.done, counted.target) if counted is not None else (0, 0)
+        progress = f"   {done} of {target} strokes done"
+        if self.streaming and counted is not None:
+            progress += f" · {counted.under_way} points now"
+        # The engine's live linearity analysis: the numbers the report will show.
+        so_far = self.app.live_result()
+        if so_far is not None:
+            self.result, self._profiles = so_far.analysis, list(so_far.profiles)
         title.append(progress, style="bold cyan")
         self.query_one("#dash-title", Static).update(title)
         self.query_one("#dash-prompt", Static).update(self._prompt(state))
@@ -218,9 +216,10 @@ class StrokeDashboardScreen(Screen[None]):
             self._say(message.text, style)
 
     def _prompt(self, state: RunnerState) -> Text:
-        if state.strokes >= state.strokes_target and not self.streaming:
+        counted = state.progress
+        if counted is not None and counted.complete and not self.streaming:
             return Text(
-                f"All {state.strokes_target} strokes are recorded. Press f to finish and see "
+                f"All {counted.target} strokes are recorded. Press f to finish and see "
                 "the verdict.",
                 style="bold green",
             )
@@ -276,10 +275,10 @@ class StrokeDashboardScreen(Screen[None]):
         state = self.app.current_state()
         if runner is None or state is None or self.streaming:
             return
-        if state.current is None or state.current.kind != "stroke" or state.status != "running":
+        if state.action.kind != "stream" or state.status != "running":
             return
-        if state.strokes >= state.strokes_target:
-            self._say(f"All {state.strokes_target} strokes are recorded: press f to finish.")
+        if state.progress is not None and state.progress.complete:
+            self._say(f"All {state.progress.target} strokes are recorded: press f to finish.")
             return
         self.streaming = True
         self._say("Streaming h, v and s: run the robot between A and B.", "yellow")
@@ -287,73 +286,17 @@ class StrokeDashboardScreen(Screen[None]):
 
     @work(thread=True, group="stroke", exit_on_error=False)
     def _stream(self) -> None:
-        """Thread worker: the strokes already in the file, then stream until the target."""
+        """Thread worker: stream until the target (the engine splits and analyses the
+        strokes; its notices carry the analysis)."""
         runner = self.app.runner
         if runner is None:
             self.post_message(StreamEnded())
             return
         try:
-            if not self._profiles and runner.state().strokes:
-                self._load_recorded(runner.path)
-            runner.stream_strokes(STREAM_TIMEOUT, on_stroke=self._on_stroke)
+            runner.stream_strokes(STREAM_TIMEOUT)
             self.post_message(StreamEnded())
         except StationError as error:
-            self.post_message(StreamEnded(error=error.message))
-
-    def _load_recorded(self, path: Any) -> None:
-        """After a resume: the whole strokes already recorded, as ``station analyze`` reads
-        them, so the charts go on from them."""
-        from station.session.model import load_session
-        from station.session.report import session_linearity_profiles
-
-        try:
-            self._profiles = list(session_linearity_profiles(load_session(path, recover=False)))
-        except StationError:
-            self._profiles = []
-        if self._profiles:
-            self._analyse()
-
-    def _on_stroke(self, outcome: Any) -> None:
-        """A whole stroke is on disk (worker thread): add it and analyse the strokes so far.
-
-        The stroke is read as ``station analyze`` reads the file's strokes (its dwell at the
-        ends trimmed by the scale's travel), so the dashboard and the report agree."""
-        from dataclasses import replace
-
-        import numpy as np
-
-        from station.analysis.linearity import profiles_from_table
-
-        profile = outcome.profile
-        position = np.asarray(profile["s"], dtype=float)
-        channels = {c: v for c, v in profile.items() if c != "s"}
-        passes = profiles_from_table(np.full(position.size, outcome.stroke), position, channels)
-        for found in passes:
-            self._profiles.append(replace(found, number=len(self._profiles) + 1))
-        self._analyse()
-
-    def _analyse(self) -> None:
-        """The linearity analysis of the strokes so far, with the session's settings (the same
-        as ``station analyze`` on the file); posted to the screen."""
-        from station.analysis.linearity import analyze_linearity, tolerance_from_limits
-        from station.runner import analysis_config
-
-        config = analysis_config(self.app.session_header)
-        try:
-            result = analyze_linearity(
-                self._profiles, tolerance=tolerance_from_limits(config), config=config
-            )
-            self.post_message(StrokeAnalysed(result=result))
-        except StationError as error:
-            self.post_message(StrokeAnalysed(error=error.message))
-
-    def on_stroke_analysed(self, message: StrokeAnalysed) -> None:
-        """Keep the newest analysis; the next redraw shows it."""
-        if message.error:
-            self._say(message.error, "bold red")
-            return
-        self.result = message.result
-        self._redraw()
+            self.post_message(StreamEnded(error=shown(error)))
 
     def on_stream_ended(self, message: StreamEnded) -> None:
         """The stream stopped: say why, and finish if the operator asked for it."""
@@ -378,9 +321,8 @@ class StrokeDashboardScreen(Screen[None]):
         state = self.app.current_state()
         if state is None:
             return
-        step = state.current.step if state.current is not None else None
-        minimum = min(int(getattr(step, "count_min", 0) or 0), state.strokes_target)
-        if state.strokes < minimum and not force:
+        counted = state.progress
+        if counted is not None and not counted.enough and not force:
             from station.tui.screens.dialogs import ConfirmScreen
 
             def finish(sure: bool | None) -> None:
@@ -389,8 +331,8 @@ class StrokeDashboardScreen(Screen[None]):
 
             self.app.push_screen(
                 ConfirmScreen(
-                    f"Finish with {state.strokes} strokes?",
-                    f"The report asks for {minimum} to {state.strokes_target}; the session "
+                    f"Finish with {counted.done} strokes?",
+                    f"The report asks for {counted.minimum} to {counted.target}; the session "
                     "is then marked incomplete.",
                 ),
                 callback=finish,
@@ -406,7 +348,7 @@ class StrokeDashboardScreen(Screen[None]):
         try:
             self.app.finish_session()
         except StationError as error:
-            self._say(error.message, "bold red")
+            self._say(shown(error), "bold red")
 
     # -- the rest -------------------------------------------------------------------------
 
@@ -435,7 +377,7 @@ class StrokeDashboardScreen(Screen[None]):
                 try:
                     runner.note(text)
                 except StationError as error:
-                    self._say(error.message, "bold red")
+                    self._say(shown(error), "bold red")
 
         self.app.push_screen(TextPrompt("Note", "What should the session file say?"), callback=save)
 

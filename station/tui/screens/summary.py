@@ -32,7 +32,7 @@ from station.tui.widgets.figures import (
 )
 
 if TYPE_CHECKING:
-    from station.runner import RunnerState
+    from station.run import RunnerState
     from station.tui.app import StationApp
 
 
@@ -50,7 +50,7 @@ class SummaryView:
     notes: tuple[str, ...] = field(default_factory=tuple)
     report: Any = None
     """A linearity or relative-accuracy session's own analysis and report block
-    (``station.session.report.SessionReport``): its ``analysis`` is then what the verdict
+    (``station.verdicts.SessionReport``): its ``analysis`` is then what the verdict
     judges."""
 
     @classmethod
@@ -73,7 +73,7 @@ class SummaryView:
     def from_file(cls, path: Path) -> SummaryView:
         """A saved session, read-only (the file is not changed, not even a torn tail)."""
         from station.session.model import load_session
-        from station.session.report import analyze_session
+        from station.verdicts import analyze_session
 
         session = load_session(path, recover=False)
         report, notes = _procedure_report(path, session.header, session)
@@ -114,7 +114,7 @@ def _procedure_report(
     """A linearity or relative-accuracy session's own analysis (None for repeatability), and
     a note saying why there is none when its file has nothing to analyse yet. ``session``: the
     file already loaded, when it is."""
-    from station.session.report import (
+    from station.verdicts import (
         PROCEDURE_REPORTS,
         load_session_source,
         report_session,

@@ -1,0 +1,296 @@
+"""What a session is set up with, before the engine runs it: the ports, the set-up the set-up
+screen or the ``station capture`` flags collect, the plan of steps, and the gauges it opens.
+"""
+
+from __future__ import annotations
+
+import math
+import socket
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from station.analysis.capability import SpecLimits
+from station.errors import StationError
+from station.instruments.base import SerialSettings
+from station.instruments.gauge import DEFAULT_BACKOFF, TRIGGERS, GaugeSet, PortSpec, Trigger
+from station.instruments.protocols import get_protocol
+from station.procedures import Procedure, Step, discover_procedures
+from station.run.steps import handler_for
+from station.run.steps.base import PlanItem
+from station.session.header import header_limits
+from station.session.model import load_session
+
+
+@dataclass(frozen=True)
+class PortSetup:
+    """One serial line: where it is, what it speaks, and which station channel each device
+    channel feeds (``{"1": "x", "2": "y", "3": "z"}``). ``settings`` ``None`` means the
+    protocol's own line settings."""
+
+    url: str
+    protocol: str
+    channel_map: Mapping[str, str]
+    settings: SerialSettings | None = None
+
+    def resolved_settings(self) -> SerialSettings:
+        """The line settings in force: the given ones, else the protocol's."""
+        return self.settings or get_protocol(self.protocol).settings
+
+    def header(self) -> dict[str, Any]:
+        """The port as it is recorded in the session header's ``instruments``."""
+        return {
+            "url": self.url,
+            "protocol": self.protocol,
+            "map": dict(self.channel_map),
+            "settings": self.resolved_settings().as_kwargs(),
+        }
+
+    @classmethod
+    def from_header(cls, recorded: Mapping[str, Any]) -> PortSetup:
+        """The port a session header recorded (for resuming on the same line)."""
+        settings = recorded.get("settings")
+        return cls(
+            url=str(recorded["url"]),
+            protocol=str(recorded["protocol"]),
+            channel_map={str(k): str(v) for k, v in dict(recorded.get("map") or {}).items()},
+            settings=SerialSettings(**settings) if settings else None,
+        )
+
+
+@dataclass(frozen=True)
+class SessionSetup:
+    """What the set-up screen or the ``station capture`` flags collect before a session starts.
+
+    ``None`` for ``unit``, ``resolution``, ``limits`` or ``cycles`` means the procedure's own
+    value. Construction validates and raises :class:`StationError` with a sentence naming the
+    field (``error.field``), so a set-up screen can show it next to the field.
+    """
+
+    procedure: Procedure
+    robot: str
+    operator: str
+    ports: tuple[PortSetup, ...]
+    trigger: Trigger = "poll"
+    unit: str | None = None
+    resolution: float | None = None
+    limits: Mapping[str, Any] | None = None
+    """Per channel a :class:`station.analysis.capability.SpecLimits` (or anything with ``lsl``,
+    ``usl`` and ``nominal``)."""
+    cycles: int | None = None
+    rule_set: str = "report"
+    threshold: float = 1.0
+    placements: int | None = None
+    """How many times each ``repeat`` block runs (fixture placements); ``None``: its target."""
+    strokes: int | None = None
+    """How many whole strokes each ``stroke`` step asks for; ``None``: its target."""
+
+    def __post_init__(self) -> None:
+        if not self.robot.strip():
+            raise StationError("the robot name is empty: name the robot under test", field="robot")
+        if self.trigger not in TRIGGERS:
+            raise StationError(
+                f"unknown trigger {self.trigger!r}: use one of {', '.join(TRIGGERS)}",
+                field="trigger",
+            )
+        for name, value in (
+            ("cycles", self.cycles),
+            ("placements", self.placements),
+            ("strokes", self.strokes),
+        ):
+            if value is not None and value < 1:
+                raise StationError(f"{name} must be at least 1, not {value}", field=name)
+        if self.resolution is not None and not (
+            math.isfinite(self.resolution) and self.resolution > 0
+        ):
+            raise StationError(
+                f"the gauge resolution must be positive, not {self.resolution}",
+                field="resolution",
+            )
+        if not math.isfinite(self.threshold) or self.threshold <= 0:
+            raise StationError(
+                f"the capability threshold must be positive, not {self.threshold}",
+                field="threshold",
+            )
+        unknown = sorted(set(self.limits or {}) - set(self.channels))
+        if unknown:
+            raise StationError(
+                f"limits given for {', '.join(unknown)}, which procedure "
+                f"{self.procedure.id!r} does not measure (its channels: "
+                f"{', '.join(self.channels)})",
+                field="limits",
+            )
+        if not self.ports:
+            raise StationError(
+                "no port given: name the serial port of the indicators", field="port"
+            )
+        mapped = {ch for port in self.ports for ch in port.channel_map.values()}
+        missing = [ch for ch in self.channels if ch not in mapped]
+        if missing:
+            raise StationError(
+                f"no device channel feeds {', '.join(missing)}",
+                field="map",
+                remedy="map_channel",
+                subject=", ".join(missing),
+            )
+
+    @property
+    def channels(self) -> tuple[str, ...]:
+        """The station channels the procedure measures, in its order."""
+        return tuple(self.procedure.channels)
+
+    @property
+    def resolved_unit(self) -> str:
+        """The session's unit: the set-up's, else the procedure's."""
+        return self.unit or self.procedure.unit
+
+    @property
+    def resolved_resolution(self) -> float:
+        """The gauge resolution: the set-up's, else the procedure's."""
+        return float(self.resolution if self.resolution is not None else self.procedure.resolution)
+
+    @property
+    def resolved_cycles(self) -> int:
+        """The number of cycles a ``cycles`` step asks for: the set-up's, else the procedure's
+        target."""
+        return int(self.cycles if self.cycles is not None else self.procedure.cycles_target)
+
+    def resolved_limits(self) -> dict[str, Any]:
+        """Spec limits per channel: the procedure's defaults overridden by the set-up's."""
+        return procedure_limits(self.procedure) | dict(self.limits or {})
+
+    def header_fields(self) -> dict[str, Any]:
+        """The session header's fields (the journal adds format, session id, created, prev).
+        Each step kind in the plan may add fields of its own (a stroke step records the
+        deadband its split uses)."""
+        fields: dict[str, Any] = {
+            "procedure": {
+                "id": self.procedure.id,
+                "version": self.procedure.version,
+                "sha256": self.procedure.sha256,
+                "analysis": self.procedure.analysis,
+            },
+            "robot": self.robot,
+            "operator": self.operator,
+            "host": socket.gethostname(),
+            "unit": self.resolved_unit,
+            "resolution": self.resolved_resolution,
+            "limits": {
+                channel: {"lsl": limits.lsl, "usl": limits.usl, "nominal": limits.nominal}
+                for channel, limits in self.resolved_limits().items()
+            },
+            "channels": list(self.channels),
+            "instruments": {
+                "trigger": self.trigger,
+                "ports": [port.header() for port in self.ports],
+            },
+            "cycles_target": self.resolved_cycles,
+            **({"placements_target": self.placements} if self.placements else {}),
+            **({"strokes_target": self.strokes} if self.strokes else {}),
+            "rules": self.rule_set,
+            "threshold": self.threshold,
+        }
+        for step in self.procedure.all_steps():
+            fields.update(handler_for(step.kind).header_fields(self, step))
+        return fields
+
+
+def procedure_limits(procedure: Procedure) -> dict[str, SpecLimits]:
+    """The procedure file's default limits, per channel."""
+    return {
+        channel: SpecLimits(lsl=limit.lsl, usl=limit.usl, nominal=limit.nominal)
+        for channel, limit in procedure.limits.items()
+    }
+
+
+def setup_from_header(
+    header: Mapping[str, Any],
+    procedure: Procedure,
+    *,
+    ports: Sequence[PortSetup] | None = None,
+) -> SessionSetup:
+    """The set-up a session header records, to resume it. ``ports`` replaces the recorded
+    ports (a USB adapter that came back under another name)."""
+    instruments = dict(header.get("instruments") or {})
+    recorded_ports = tuple(PortSetup.from_header(p) for p in instruments.get("ports") or ())
+    cycles = header.get("cycles_target")
+    placements, strokes = header.get("placements_target"), header.get("strokes_target")
+    return SessionSetup(
+        procedure=procedure,
+        robot=str(header["robot"]),
+        operator=str(header.get("operator") or ""),
+        ports=tuple(ports) if ports else recorded_ports,
+        trigger=instruments.get("trigger", "poll"),
+        unit=str(header["unit"]),
+        resolution=float(header["resolution"]) if header.get("resolution") else None,
+        limits=header_limits(header),
+        cycles=int(cycles) if isinstance(cycles, int) else None,
+        rule_set=str(header.get("rules") or "report"),
+        threshold=float(header.get("threshold") or 1.0),
+        placements=placements if isinstance(placements, int) else None,
+        strokes=strokes if isinstance(strokes, int) else None,
+    )
+
+
+def resume_setup(
+    path: str | Path,
+    *,
+    procedures_dirs: Sequence[str | Path] = (),
+    ports: Sequence[PortSetup] | None = None,
+) -> SessionSetup:
+    """The set-up of the session in ``path`` (its procedure found by id), to resume it."""
+    session = load_session(path, recover=False)
+    if session.finished:
+        raise StationError(f"session {path} is finished; start a new session instead")
+    procedure = discover_procedures(procedures_dirs).get(session.procedure_id)
+    return setup_from_header(session.header, procedure, ports=ports)
+
+
+def open_gauges(
+    setup: SessionSetup,
+    *,
+    backoff: tuple[float, float] | None = None,
+    on_reading: Callable[[Any], object] | None = None,
+    poll_interval: float = 0.1,
+) -> GaugeSet:
+    """Build and start the :class:`~station.instruments.gauge.GaugeSet` the set-up describes.
+
+    The engine subscribes to its sets and port changes; ``on_reading`` (every accepted frame,
+    on a reader thread) is for a live display. The caller stops the set when done.
+    """
+    specs = [
+        PortSpec(
+            url=port.url,
+            protocol=get_protocol(port.protocol),
+            channel_map=dict(port.channel_map),
+            settings=port.settings,
+        )
+        for port in setup.ports
+    ]
+    gauges = GaugeSet(
+        specs,
+        trigger=setup.trigger,
+        unit=setup.resolved_unit,
+        resolution=setup.resolved_resolution,
+        poll_interval=poll_interval,
+        on_reading=on_reading,
+        backoff=backoff or DEFAULT_BACKOFF,
+    )
+    gauges.start()
+    return gauges
+
+
+def unroll(procedure: Procedure, placements: int | None = None) -> tuple[PlanItem, ...]:
+    """The procedure's steps in the order a session walks them (each step kind's handler says
+    whether it is a block to repeat)."""
+    items: list[PlanItem] = []
+    for step in procedure.steps:
+        items.extend(handler_for(step.kind).unroll(step, placements))
+    return tuple(items)
+
+
+def plan_steps(setup: SessionSetup) -> tuple[tuple[Step, int | None], ...]:
+    """The steps a session of ``setup`` walks, in order, each with its placement (a repeat
+    block's steps once per placement; ``None`` outside one)."""
+    return tuple((item.step, item.placement) for item in unroll(setup.procedure, setup.placements))

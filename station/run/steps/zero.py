@@ -1,0 +1,68 @@
+"""``zero``: zero the indicators at the taught pose (the gauge's own command where it has one,
+else a software offset from the readings)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from station.errors import StationError
+from station.procedures import StepSchema
+from station.run.state import Action
+from station.run.steps import register
+from station.run.steps.base import PlanItem, StepHandler
+
+if TYPE_CHECKING:
+    from station.run.engine import Runner
+
+ZERO_TIMEOUT = 5.0
+
+
+class ZeroStep(StepHandler):
+    """Done when the ``zero`` event (per channel: method and offset) is on disk."""
+
+    kind = "zero"
+    schema = StepSchema(channels=True)
+    confirm_waits = True
+
+    def action(self, run: Runner, item: PlanItem) -> Action:
+        return Action("zero", prompt=self.prompt(run, item))
+
+    def confirm(self, run: Runner, item: PlanItem, by: str) -> None:
+        # Confirming a zero step is zeroing: the engine releases its lock for the wait.
+        run.zero(by=by)
+
+    def zero(self, run: Runner, item: PlanItem, by: str, timeout: float) -> None:
+        """A port that is down is waited for until ``timeout``; a gauge reading in another unit
+        than the session's is refused (nothing zeroed)."""
+        with run.lock:
+            run.claim()
+        try:
+            results = run.gauges.zero(
+                list(item.step.channels), timeout, unit=run.setup.resolved_unit
+            )
+        except StationError as error:
+            with run.lock:
+                run.release()
+                run.say("error", error.message)
+            raise
+        except BaseException:
+            with run.lock:
+                run.release()
+            raise
+        with run.lock:
+            run.release()
+            run.ensure_open()
+            run.append(
+                "zero",
+                step=item.step.id,
+                placement=item.placement,
+                channels={
+                    result.channel: {"method": result.method, "offset": result.offset}
+                    for result in results
+                },
+                by=by,
+            )
+            run.complete_step(item, by)
+
+
+register(ZeroStep())

@@ -1,0 +1,113 @@
+"""The session header, typed: what line 1 of a session file says and what it implies.
+
+The engine writes the header from a set-up; the analysis of a running session and the batch
+analysis of its file both read their settings through :func:`analysis_config`, so the two agree.
+This module is the one place that turns a header mapping into limits and an analysis
+configuration (the session package never reaches up into the engine for it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from station.analysis.capability import SpecLimits
+from station.analysis.summary import AnalysisConfig
+
+
+def header_limits(header: Mapping[str, Any]) -> dict[str, SpecLimits]:
+    """The spec limits a session header records, as a :class:`SpecLimits` per channel it
+    measures; a channel with neither an LSL nor a USL has none."""
+    channels = header.get("channels")
+    return {
+        str(channel): SpecLimits(
+            lsl=spec.get("lsl"), usl=spec.get("usl"), nominal=spec.get("nominal")
+        )
+        for channel, spec in dict(header.get("limits") or {}).items()
+        if (channels is None or channel in channels)
+        and isinstance(spec, Mapping)
+        and (spec.get("lsl") is not None or spec.get("usl") is not None)
+    }
+
+
+def analysis_config(header: Mapping[str, Any]) -> AnalysisConfig:
+    """The :class:`AnalysisConfig` a session header implies: its limits, resolution, unit, rule
+    set and threshold (single readings, subgroup 1)."""
+    resolution = header.get("resolution")
+    return AnalysisConfig(
+        limits=header_limits(header),
+        resolution=float(resolution) if isinstance(resolution, int | float) else None,
+        unit=str(header.get("unit") or ""),
+        rule_set=str(header.get("rules") or "report"),
+        threshold=float(header.get("threshold") or 1.0),
+    )
+
+
+@dataclass(frozen=True)
+class SessionHeader:
+    """The fields of a session header that the engine and the analyses read."""
+
+    procedure_id: str
+    procedure_version: str
+    procedure_sha256: str
+    analysis: str | None
+    """The analysis kind the procedure declared when the session began (None in old files)."""
+    robot: str
+    operator: str
+    unit: str
+    resolution: float | None
+    channels: tuple[str, ...]
+    trigger: str
+    ports: tuple[Mapping[str, Any], ...]
+    cycles_target: int | None
+    placements_target: int | None
+    strokes_target: int | None
+    rules: str
+    threshold: float
+    deadband: float | None
+    """The travel deadband the stroke split used (linearity), in the session's unit."""
+    raw: Mapping[str, Any]
+
+    @classmethod
+    def from_mapping(cls, header: Mapping[str, Any]) -> SessionHeader:
+        """Read a header mapping (line 1 of a session file)."""
+        procedure = dict(header.get("procedure") or {})
+        instruments = dict(header.get("instruments") or {})
+
+        def count(key: str) -> int | None:
+            value = header.get(key)
+            return value if isinstance(value, int) and not isinstance(value, bool) else None
+
+        resolution = header.get("resolution")
+        deadband = header.get("deadband")
+        return cls(
+            procedure_id=str(procedure.get("id") or ""),
+            procedure_version=str(procedure.get("version") or ""),
+            procedure_sha256=str(procedure.get("sha256") or ""),
+            analysis=str(procedure["analysis"]) if procedure.get("analysis") else None,
+            robot=str(header.get("robot") or ""),
+            operator=str(header.get("operator") or ""),
+            unit=str(header.get("unit") or ""),
+            resolution=float(resolution) if isinstance(resolution, int | float) else None,
+            channels=tuple(str(c) for c in header.get("channels") or ()),
+            trigger=str(instruments.get("trigger") or "poll"),
+            ports=tuple(dict(p) for p in instruments.get("ports") or () if isinstance(p, Mapping)),
+            cycles_target=count("cycles_target"),
+            placements_target=count("placements_target"),
+            strokes_target=count("strokes_target"),
+            rules=str(header.get("rules") or "report"),
+            threshold=float(header.get("threshold") or 1.0),
+            deadband=float(deadband) if isinstance(deadband, int | float) else None,
+            raw=header,
+        )
+
+    @property
+    def limits(self) -> dict[str, SpecLimits]:
+        """Spec limits per channel (:func:`header_limits`)."""
+        return header_limits(self.raw)
+
+    @property
+    def config(self) -> AnalysisConfig:
+        """The analysis configuration (:func:`analysis_config`)."""
+        return analysis_config(self.raw)

@@ -1,0 +1,203 @@
+"""Text in and out, in one place: channel maps, limits, numbers at a gauge's resolution and the
+verdict words.
+
+Both front ends (the set-up screen and the command line) read what the operator typed with these
+functions, and every screen, report and command prints numbers and verdicts with them, so a
+value looks the same wherever it is shown and a typing rule is the same wherever it is typed.
+Errors are :class:`~station.errors.StationError` sentences that name no option or key (the
+front end adds where to type).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+from decimal import Decimal
+from typing import Any
+
+from station.errors import StationError
+
+NOT_AVAILABLE = "-"
+"""What a figure that is undefined shows (σ of one reading, Cpk without limits)."""
+
+LIMIT_HELP = "±0.001 or LSL:USL, e.g. -0.001:0.0015 (one side may be empty)"
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+
+
+# -- numbers at a resolution ------------------------------------------------------------------
+
+
+def value_decimals(resolution: float | None) -> int:
+    """How many decimals a gauge of ``resolution`` shows (0.0001 -> 4, 0.0005 -> 4, 0.002 -> 3,
+    1e-05 -> 5); 5 when the resolution is unknown."""
+    if resolution is None or not math.isfinite(resolution) or resolution <= 0:
+        return 5
+    exponent = Decimal(repr(float(resolution))).normalize().as_tuple().exponent
+    return max(0, -int(exponent))
+
+
+def format_value(value: float | None, resolution: float | None, *, signed: bool = True) -> str:
+    """A reading as the gauge shows it: signed, at its resolution's decimals (``+0.0012``);
+    ``-`` when undefined.
+
+    Rounding to the display is what the operator reads; the file keeps the full value."""
+    if value is None or not math.isfinite(value):
+        return NOT_AVAILABLE
+    decimals = value_decimals(resolution)
+    if not signed:
+        return f"{value:.{decimals}f}"
+    text = f"{value:+.{decimals}f}"
+    # -0.00004 at four decimals would read "-0.0000": a zero has no sign worth showing.
+    return "+" + text[1:] if text.startswith("-") and not text.strip("-0.") else text
+
+
+def format_spread(value: float | None, resolution: float | None) -> str:
+    """A spread (σ, range) at one decimal more than the gauge shows, unsigned."""
+    if value is None or not math.isfinite(value):
+        return NOT_AVAILABLE
+    return f"{value:.{value_decimals(resolution) + 1}f}"
+
+
+def format_index(value: float | None) -> str:
+    """A capability index (Cp, Cpk) or a₁ with two decimals, or ``-`` when undefined."""
+    if value is None or not math.isfinite(value):
+        return NOT_AVAILABLE
+    return f"{value:.2f}"
+
+
+# -- verdict words ----------------------------------------------------------------------------
+
+CAPABLE, NOT_CAPABLE, UNDEFINED = "CAPABLE", "NOT CAPABLE", "UNDEFINED"
+
+
+def verdict_word(capability: Any) -> str:
+    """CAPABLE, NOT CAPABLE or UNDEFINED from ``capability.capable`` (True, False, None): the
+    verdict is always a word, never only a colour."""
+    capable = getattr(capability, "capable", None) if capability is not None else None
+    if capable is True:
+        return CAPABLE
+    if capable is False:
+        return NOT_CAPABLE
+    return UNDEFINED
+
+
+def overall_verdict(words: Iterable[str]) -> str:
+    """The session's verdict: NOT CAPABLE if any axis is, CAPABLE if all are, else UNDEFINED."""
+    words = list(words)
+    if not words:
+        return UNDEFINED
+    if NOT_CAPABLE in words:
+        return NOT_CAPABLE
+    if all(word == CAPABLE for word in words):
+        return CAPABLE
+    return UNDEFINED
+
+
+# -- channel maps -----------------------------------------------------------------------------
+
+
+def parse_channel_map(text: str | None) -> dict[str, str]:
+    """``"1=x,2=y,3=z"`` -> ``{"1": "x", "2": "y", "3": "z"}``; ``{}`` when empty.
+
+    The strict rule of both front ends: every pair is ``DEVICE=CHANNEL``, a device channel is
+    named once, and no two device channels feed one station channel."""
+    if text is None or not text.strip():
+        return {}
+    mapping: dict[str, str] = {}
+    for part in filter(None, (p.strip() for p in text.split(","))):
+        device, sep, channel = (piece.strip() for piece in part.partition("="))
+        if not sep or not device or not channel:
+            raise StationError(
+                f"{part!r} is not DEVICE=CHANNEL: write pairs separated by commas, "
+                "e.g. 1=x,2=y,3=z",
+                field="map",
+            )
+        if device in mapping:
+            raise StationError(f"the channel map names device channel {device} twice", field="map")
+        mapping[device] = channel
+    fed = [channel for channel in mapping.values()]
+    doubled = sorted({channel for channel in fed if fed.count(channel) > 1})
+    if doubled:
+        raise StationError(
+            f"the channel map feeds {', '.join(doubled)} from two device channels", field="map"
+        )
+    return mapping
+
+
+def channel_map_text(mapping: dict[str, str]) -> str:
+    """The text form of a channel map (``1=x,2=y,3=z``), the inverse of
+    :func:`parse_channel_map`."""
+    return ",".join(f"{device}={channel}" for device, channel in mapping.items())
+
+
+# -- limits -----------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class TypedLimits:
+    """Parsed limits: the lower and upper limit and the nominal (None when absent)."""
+
+    lsl: float | None
+    usl: float | None
+    nominal: float | None
+
+
+def parse_limits_text(text: str) -> TypedLimits | None:
+    """``±0.001``, ``+-0.001``, ``0.001`` (a tolerance about 0), or ``LSL:USL``; None when empty.
+
+    Raises StationError with a sentence naming the rule (``field="limits"``)."""
+    text = text.strip().replace(" ", "")
+    if not text:
+        return None
+    tolerance = re.fullmatch(rf"(?:±|\+-|\+/-)?({_NUMBER})", text)
+    if tolerance and ":" not in text:
+        value = float(tolerance.group(1))
+        if not math.isfinite(value) or value <= 0:
+            raise StationError(
+                f"a tolerance must be a positive number, not {text}: {LIMIT_HELP}", field="limits"
+            )
+        return TypedLimits(lsl=-value, usl=value, nominal=0.0)
+    both = re.fullmatch(rf"({_NUMBER})?:({_NUMBER})?", text)
+    if not both or (both.group(1) is None and both.group(2) is None):
+        raise StationError(f"{text!r} is not a limit: write {LIMIT_HELP}", field="limits")
+    lsl = float(both.group(1)) if both.group(1) is not None else None
+    usl = float(both.group(2)) if both.group(2) is not None else None
+    for value in (lsl, usl):
+        if value is not None and not math.isfinite(value):
+            raise StationError(f"{text!r}: a limit must be a finite number", field="limits")
+    if lsl is not None and usl is not None and usl <= lsl:
+        raise StationError(
+            f"the upper limit {usl:g} is not above the lower limit {lsl:g}: swap them",
+            field="limits",
+        )
+    nominal = 0.0 if lsl is None or usl is None else None
+    return TypedLimits(lsl=lsl, usl=usl, nominal=nominal)
+
+
+def parse_channel_limits(
+    text: str, channels: Iterable[str] | None = None
+) -> tuple[str, TypedLimits]:
+    """``CH=LIMITS`` (``x=-0.001:0.001`` or ``x=±0.001``) -> the channel and its limits."""
+    channel, sep, limits = (piece.strip() for piece in text.partition("="))
+    if not sep or not channel:
+        raise StationError(f"{text!r} is not CH=LSL:USL, e.g. x=-0.001:0.001", field="limits")
+    known = tuple(channels) if channels is not None else None
+    if known is not None and channel not in known:
+        raise StationError(
+            f"limits given for {channel}, which is not measured here (channels: "
+            f"{', '.join(known)})",
+            field="limits",
+        )
+    parsed = parse_limits_text(limits)
+    if parsed is None:
+        raise StationError(f"{text!r} gives no limits for {channel}", field="limits")
+    return channel, parsed
+
+
+def limits_text(lsl: float | None, usl: float | None, nominal: float | None = None) -> str:
+    """The typed form of limits: ``±tol`` when symmetric about 0, else ``LSL:USL``."""
+    if lsl is not None and usl is not None and math.isclose(-lsl, usl) and not nominal:
+        return f"±{usl:g}"
+    return f"{'' if lsl is None else f'{lsl:g}'}:{'' if usl is None else f'{usl:g}'}"
