@@ -13,9 +13,8 @@ import pytest
 
 from station.analysis.summary import analyze, to_json
 from station.errors import StationError
-from station.instruments.protocols import get_protocol
-from station.instruments.simulator import Faults, GaugeSpec, Simulator, fixture_model
-from station.run import PortSetup, Runner, RunnerNotice, SessionSetup
+from station.instruments.simulator import Faults
+from station.run import Runner, RunnerNotice
 from station.session.header import analysis_config
 from station.session.model import load_session
 from station.session.verify import verify_session
@@ -25,7 +24,6 @@ from .conftest import (
     every_kind_procedure,
     make_simulator,
     setup_for,
-    strokes_procedure,
 )
 
 
