@@ -23,6 +23,7 @@ from textual.widgets import Footer, Static
 
 from station.errors import StationError
 from station.tui.messages import CaptureFinished
+from station.tui.remedies import shown
 from station.tui.widgets.alarm_log import AlarmLog, alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.figures import decimals_for
@@ -289,7 +290,10 @@ class DashboardScreen(Screen[None]):
         try:
             call()
         except StationError as error:
-            self.app.call_from_thread(self._say, error.message, "bold red")
+            self.app.call_from_thread(self._say, shown(error), "bold red")
+        except Exception as error:  # a bug: shown, never swallowed by the worker
+            self.app.call_from_thread(self._say, f"internal error: {error!r}", "bold red")
+            raise
         finally:
             self.app.call_from_thread(self._action_done)
 

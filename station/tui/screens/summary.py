@@ -60,7 +60,7 @@ class SummaryView:
         return cls(
             path=state.path,
             header=dict(header),
-            analysis=report.analysis if report is not None else analysis,
+            analysis=report.analysis if report is not None and report.analysis else analysis,
             last_hash=state.last_hash,
             status=state.status,
             cycle_numbers=tuple(r.cycle for r in state.cycles if r.rejected is None),
@@ -73,11 +73,10 @@ class SummaryView:
     def from_file(cls, path: Path) -> SummaryView:
         """A saved session, read-only (the file is not changed, not even a torn tail)."""
         from station.session.model import load_session
-        from station.verdicts import analyze_session
 
         session = load_session(path, recover=False)
         report, notes = _procedure_report(path, session.header, session)
-        analysis = report.analysis if report is not None else analyze_session(session)
+        analysis = report.analysis if report is not None else None
         if session.torn is not None:
             notes = (*notes, session.torn.message)
         return cls(
@@ -111,26 +110,13 @@ REPORT_WIDTH = 74
 def _procedure_report(
     path: Path, header: Mapping[str, Any], session: Any = None
 ) -> tuple[Any, tuple[str, ...]]:
-    """A linearity or relative-accuracy session's own analysis (None for repeatability), and
-    a note saying why there is none when its file has nothing to analyse yet. ``session``: the
-    file already loaded, when it is."""
-    from station.verdicts import (
-        PROCEDURE_REPORTS,
-        load_session_source,
-        report_session,
-        session_source,
-    )
+    """The session's report as its analysis kind makes it (through the registry: the verdict,
+    and for kinds with a report block of their own, that block), and a note saying why there
+    is none when the file has nothing to analyse yet. ``session``: the file already loaded."""
+    from station.verdicts import load_session_source, report_session, session_source
 
-    procedure = header.get("procedure")
-    recorded = procedure if isinstance(procedure, Mapping) else {"id": procedure}
-    # The analysis the procedure declares (a site's own accuracy procedure has its own id).
-    kind = recorded.get("analysis") or recorded.get("id")
-    if kind not in PROCEDURE_REPORTS and "analysis" in recorded:
-        return None, ()
     try:
         source = load_session_source(path) if session is None else session_source(session)
-        if source.analysis not in PROCEDURE_REPORTS:
-            return None, ()
         return report_session(source, width=REPORT_WIDTH), ()
     except StationError as error:
         return None, (error.message,)
@@ -259,9 +245,8 @@ class SummaryScreen(Screen[None]):
             f"  robot {header.get('robot', '?')} · {procedure.get('id', '')} · operator "
             f"{header.get('operator') or 'not given'} · "
             + (
-                self.view.report.count
-                if self.view.report is not None
-                else f"{len(self.view.cycle_numbers)} cycles"
+                (self.view.report.count if self.view.report is not None else None)
+                or f"{len(self.view.cycle_numbers)} cycles"
             ),
         )
         yield Static(title, id="summary-title")
@@ -269,7 +254,7 @@ class SummaryScreen(Screen[None]):
             yield Static(_trimmed(verdict_text(self.view)), id="summary-verdict")
             yield Static(_trimmed(spatial_text(self.view)), id="summary-spatial")
             report = Static(report_text(self.view), id="summary-report")
-            report.display = self.view.report is not None
+            report.display = self.view.report is not None and bool(self.view.report.sections)
             yield report
             yield Static(hints_text(self.view), id="summary-hints")
             yield Static(file_text(self.view, self.exported), id="summary-file")
