@@ -38,7 +38,9 @@ def export_csv(session: Session, out: TextIO) -> int:
     for number in sorted(session.cycles):
         cycle = session.cycles[number]
         reason = session.rejected.get(number)
-        status = "ok" if reason is None else f"rejected: {reason}"
+        # One line per row: a reason typed with a line break must not split the row for a
+        # reader that takes the file line by line (``station analyze`` does).
+        status = "ok" if reason is None else f"rejected: {one_line(reason)}"
         for channel in (*session.channels, *sorted(set(cycle.readings) - set(session.channels))):
             reading = cycle.readings.get(channel)
             if reading is None:
@@ -58,3 +60,9 @@ def export_csv(session: Session, out: TextIO) -> int:
             )
             rows += 1
     return rows
+
+
+def one_line(text: object) -> str:
+    """``text`` on one line: every line break or other non-printable character becomes a
+    space (a CSV row or a ``#`` comment must not be split by a reason typed with Enter)."""
+    return " ".join("".join(c if c.isprintable() else " " for c in str(text)).split())
