@@ -1,0 +1,274 @@
+"""The report's charts as SVG text (matplotlib's SVG backend, no display, no global state).
+
+Each chart is one ``Figure`` drawn by ``FigureCanvasSVG``: the histogram of each channel against
+its limits, the control chart with its limits and the alarms marked, the 3-D offsets of x, y, z,
+the linearity profiles (least-squares line and minimum zone of the widest stroke), and the
+readings over time with their trend (drift). Text is kept as SVG text (searchable, small), and
+maths parsing is off: a channel name is shown as typed.
+"""
+
+from __future__ import annotations
+
+import io
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+from station.record.content import parse_time
+from station.record.source import AnalysedSession
+
+RC = {
+    "svg.fonttype": "none",
+    "text.parse_math": False,
+    "text.usetex": False,
+    "font.size": 9,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+}
+LIMIT_COLOUR = "#c0392b"
+CENTRE_COLOUR = "#2c3e50"
+POINT_COLOUR = "#1f77b4"
+ALARM_COLOUR = "#d62728"
+
+
+@dataclass(frozen=True)
+class Chart:
+    """One chart: its title (for a caption) and its SVG element (no XML prolog)."""
+
+    key: str
+    title: str
+    svg: str
+
+
+def _svg(figure: Any, salt: str) -> str:
+    """The figure as an inline ``<svg>`` element: prolog and doctype dropped, ids made unique
+    per chart (several charts share one HTML page)."""
+    from matplotlib import rc_context
+    from matplotlib.backends.backend_svg import FigureCanvasSVG
+
+    buffer = io.StringIO()
+    with rc_context({**RC, "svg.hashsalt": salt}):
+        FigureCanvasSVG(figure).print_svg(buffer)
+    text = buffer.getvalue()
+    start = text.find("<svg")
+    return text[start:] if start >= 0 else text
+
+
+def _figure(width: float = 7.0, height: float = 3.2) -> Any:
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=(width, height), layout="constrained")
+
+
+def histogram_chart(name: str, channel: Any, unit: str) -> Any:
+    """The readings' histogram with LSL, USL, nominal and the mean marked."""
+    import numpy as np
+
+    figure = _figure()
+    axes = figure.add_subplot()
+    values = np.asarray(channel.readings, dtype=float)
+    bins = min(30, max(5, int(np.sqrt(values.size)) + 1))
+    axes.hist(values, bins=bins, color=POINT_COLOUR, alpha=0.75, edgecolor="white")
+    limits = channel.limits
+    if limits is not None:
+        for value, label in ((limits.lsl, "LSL"), (limits.usl, "USL")):
+            if value is not None:
+                axes.axvline(value, color=LIMIT_COLOUR, linestyle="--", label=f"{label} {value:g}")
+    axes.axvline(channel.nominal, color="grey", linestyle=":", label="nominal")
+    axes.axvline(channel.descriptive.mean, color=CENTRE_COLOUR, label="mean")
+    axes.set_title(f"Histogram of {name} against the limits")
+    axes.set_xlabel(f"reading ({unit})" if unit else "reading")
+    axes.set_ylabel("count")
+    axes.legend(loc="upper right", fontsize=7)
+    return figure
+
+
+def control_chart(name: str, channel: Any) -> Any:
+    """The location chart: points by cycle, centre line, control limits, alarms in red."""
+    import numpy as np
+
+    chart = channel.chart
+    figure = _figure()
+    axes = figure.add_subplot()
+    points = np.asarray(chart.points, dtype=float)
+    subgroup = max(1, chart.subgroup)
+    labels = channel.cycles or tuple(range(1, len(channel.readings) + 1))
+    x = np.asarray([labels[min(i * subgroup, len(labels) - 1)] for i in range(points.size)])
+    axes.plot(x, points, marker="o", markersize=3, color=POINT_COLOUR, linewidth=1)
+    for value, label, style in (
+        (chart.center, "CL", "-"),
+        (chart.ucl, "UCL", "--"),
+        (chart.lcl, "LCL", "--"),
+    ):
+        if value is not None:
+            colour = CENTRE_COLOUR if label == "CL" else LIMIT_COLOUR
+            axes.axhline(value, color=colour, linestyle=style, linewidth=1, label=label)
+    flagged = sorted({p for alarm in channel.alarms for p in alarm.points if 0 <= p < points.size})
+    if flagged:
+        axes.scatter(
+            x[flagged],
+            points[flagged],
+            s=60,
+            facecolors="none",
+            edgecolors=ALARM_COLOUR,
+            linewidths=1.5,
+            label=f"alarm ({len(channel.alarms)})",
+            zorder=3,
+        )
+    axes.set_title(f"Control chart ({chart.type}) of {name}")
+    axes.set_xlabel("cycle")
+    axes.legend(loc="upper right", fontsize=7)
+    return figure
+
+
+def offsets_chart(analysis: Any, unit: str) -> Any:
+    """The x, y, z readings in 3-D with the nominal and the mean (the offset) marked."""
+    import numpy as np
+
+    spatial = analysis.spatial
+    channels = analysis.channels
+    names = [n for n in channels if n.lower() in ("x", "y", "z")]
+    arrays = [np.asarray(channels[n].readings, dtype=float) for n in names]
+    figure = _figure(5.5, 4.5)
+    axes = figure.add_subplot(projection="3d")
+    axes.scatter(*arrays, s=8, color=POINT_COLOUR, alpha=0.6, label="readings")
+    nominal = [spatial.nominal[a] for a in ("x", "y", "z")]
+    mean = [nominal[i] + spatial.offset[a] for i, a in enumerate(("x", "y", "z"))]
+    axes.scatter(*[[v] for v in nominal], s=50, color="grey", marker="+", label="nominal")
+    axes.scatter(*[[v] for v in mean], s=50, color=ALARM_COLOUR, marker="x", label="mean")
+    axes.plot(*[[n, m] for n, m in zip(nominal, mean, strict=True)], color=ALARM_COLOUR)
+    suffix = f" ({unit})" if unit else ""
+    axes.set_xlabel("x" + suffix)
+    axes.set_ylabel("y" + suffix)
+    axes.set_zlabel("z" + suffix)
+    axes.set_title("3-D offsets from nominal")
+    axes.legend(loc="upper left", fontsize=7)
+    return figure
+
+
+def linearity_chart(channel: str, analysed: AnalysedSession, unit: str) -> Any:
+    """Every stroke's deviation along the bar (grey), the widest stroke in colour with its
+    least-squares line and its minimum zone (two parallel lines)."""
+    import numpy as np
+
+    result = analysed.report.result  # type: ignore[union-attr]
+    profiles = {p.number: p for p in analysed.profiles}
+    figure = _figure()
+    axes = figure.add_subplot()
+    for profile in analysed.profiles:
+        axes.plot(profile.s, profile.channels[channel], color="lightgrey", linewidth=0.8)
+    widest = max(result.strokes, key=lambda r: r.straightness[channel].mz, default=None)
+    if widest is not None and widest.number in profiles:
+        profile = profiles[widest.number]
+        s = np.asarray(profile.s, dtype=float)
+        d = np.asarray(profile.channels[channel], dtype=float)
+        straight = widest.straightness[channel]
+        axes.plot(s, d, color=POINT_COLOUR, linewidth=1.2, label=f"stroke {widest.number}")
+        a, b = straight.ls_line
+        axes.plot(s, a + b * s, color=CENTRE_COLOUR, label=f"LS line (LS {straight.ls:.4g})")
+        a, b = straight.mz_line
+        for offset in (-straight.mz / 2, straight.mz / 2):
+            axes.plot(
+                s,
+                a + b * s + offset,
+                color=LIMIT_COLOUR,
+                linestyle="--",
+                label=f"minimum zone (MZ {straight.mz:.4g})" if offset > 0 else None,
+            )
+    suffix = f" ({unit})" if unit else ""
+    axes.set_title(f"Straightness profiles of {channel} along the bar")
+    axes.set_xlabel("position s" + suffix)
+    axes.set_ylabel(f"deviation {channel}{suffix}")
+    axes.legend(loc="upper right", fontsize=7)
+    return figure
+
+
+def drift_chart(analysed: AnalysedSession, unit: str) -> Any | None:
+    """Each channel's accepted readings against the minutes since the first, with its
+    least-squares trend; None with fewer than three timed cycles."""
+    import numpy as np
+
+    session = analysed.session
+    numbers = session.accepted_cycles
+    if len(numbers) < 3:
+        return None
+    first = parse_time(session.cycles[numbers[0]].t)
+    if first is None:
+        return None
+    figure = _figure()
+    axes = figure.add_subplot()
+    drawn = False
+    for channel in session.channels:
+        pairs = []
+        for n in numbers:
+            cycle = session.cycles[n]
+            moment = parse_time(cycle.t)
+            if channel in cycle.readings and moment is not None:
+                pairs.append(((moment - first).total_seconds() / 60, cycle.readings[channel].value))
+        if len(pairs) < 3:
+            continue
+        minutes, values = (np.asarray(v, dtype=float) for v in zip(*pairs, strict=True))
+        (line,) = axes.plot(minutes, values, marker=".", linewidth=0.8, label=channel)
+        if np.ptp(minutes) > 0:
+            slope, intercept = np.polyfit(minutes, values, 1)
+            axes.plot(
+                minutes,
+                intercept + slope * minutes,
+                color=line.get_color(),
+                linestyle="--",
+                label=f"{channel} trend {slope:+.3g}/min",
+            )
+        drawn = True
+    if not drawn:
+        return None
+    axes.set_title("Readings over time (drift)")
+    axes.set_xlabel("minutes since the first cycle")
+    axes.set_ylabel(f"reading ({unit})" if unit else "reading")
+    axes.legend(loc="upper right", fontsize=7)
+    return figure
+
+
+def _figures(analysed: AnalysedSession) -> Iterator[tuple[str, str, Any]]:
+    report = analysed.report
+    if report is None or report.analysis is None:
+        return
+    analysis = report.analysis
+    unit = analysis.config.unit
+    if analysed.kind == "linearity":
+        for channel in report.result.channels:
+            yield (
+                f"profile-{channel}",
+                f"Linearity profiles of {channel}",
+                linearity_chart(channel, analysed, unit),
+            )
+    for key, channel in analysis.channels.items():
+        yield (
+            f"histogram-{key}",
+            f"Histogram of {channel.name}",
+            histogram_chart(channel.name, channel, unit),
+        )
+        if channel.chart.points:
+            yield (
+                f"control-{key}",
+                f"Control chart of {channel.name}",
+                control_chart(channel.name, channel),
+            )
+    if analysis.spatial is not None:
+        yield "offsets-3d", "3-D offsets", offsets_chart(analysis, unit)
+    if analysed.kind != "linearity":
+        drift = drift_chart(analysed, unit)
+        if drift is not None:
+            yield "drift", "Readings over time (drift)", drift
+
+
+_SAFE_KEY = re.compile(r"[^A-Za-z0-9_-]")
+
+
+def report_charts(analysed: AnalysedSession) -> list[Chart]:
+    """Every chart of the session's report, as SVG (empty without an analysis)."""
+    charts = []
+    for number, (key, title, figure) in enumerate(_figures(analysed)):
+        safe = f"{number}-{_SAFE_KEY.sub('_', key)}"
+        charts.append(Chart(key=safe, title=title, svg=_svg(figure, f"station-chart-{safe}")))
+    return charts

@@ -1,0 +1,460 @@
+"""What a filed report says: one content model built from a session file, shown in txt, md or
+html by :mod:`station.record.render`.
+
+Everything is formatted here, once, so the three formats cannot disagree: the robot, operator,
+procedure (id, version, sha256), date and duration, gauges, zeroes, limits, every reading with
+the rejects and their reasons, notes, alarms with their acknowledgements, the verdicts with the
+lower confidence bound of Cpk, hints, the procedure's own blocks, the anchor (the last line's
+hash) and the signature id, and the sign-off lines. Text from outside stays raw here; each
+format escapes it (see :mod:`station.record.text`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from datetime import datetime
+from typing import Any
+
+from station.record.source import AnalysedSession
+
+MISSING = "—"
+SIGN_OFF = ("Tested by", "Reviewed by")
+
+
+@dataclass(frozen=True)
+class Gauge:
+    """One serial line of the session: where, what protocol, which channels, serials."""
+
+    port: str
+    protocol: str
+    channels: str
+    serials: str
+    settings: str
+
+
+@dataclass(frozen=True)
+class ZeroLine:
+    """One channel of one zero event: how the indicator was zeroed and the offset taken."""
+
+    time: str
+    step: str
+    channel: str
+    method: str
+    offset: str
+
+
+@dataclass(frozen=True)
+class LimitLine:
+    """The specification limits of one channel."""
+
+    channel: str
+    lsl: str
+    usl: str
+    nominal: str
+
+
+@dataclass(frozen=True)
+class ReadingRow:
+    """One recorded cycle: its values per channel (in ``ReportContent.channels`` order) and its
+    status, ``ok`` or ``rejected: <reason>`` (readings are never deleted)."""
+
+    cycle: str
+    time: str
+    placement: str
+    values: tuple[str, ...]
+    status: str
+
+
+@dataclass(frozen=True)
+class NoteLine:
+    """One note the operator (or the engine) wrote."""
+
+    time: str
+    by: str
+    text: str
+
+
+@dataclass(frozen=True)
+class AlarmLine:
+    """One recorded alarm and its acknowledgement (``acknowledged`` is MISSING without one)."""
+
+    time: str
+    channel: str
+    rule: str
+    cycles: str
+    text: str
+    acknowledged: str
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """One judged channel: n, mean, σ, Cp, Cpk with its lower confidence bound, the word."""
+
+    channel: str
+    name: str
+    n: str
+    mean: str
+    sd: str
+    cp: str
+    cpk: str
+    cpk_lower: str
+    word: str
+    message: str
+
+
+@dataclass(frozen=True)
+class ReportContent:
+    """The facts of one filed report, every value already formatted as text."""
+
+    title: str
+    file_name: str
+    kind: str
+    session_id: str
+    robot: str
+    operator: str
+    host: str
+    procedure_id: str
+    procedure_version: str
+    procedure_sha256: str
+    created: str
+    ended: str
+    duration: str
+    status: str
+    unit: str
+    resolution: str
+    rules: str
+    threshold: str
+    trigger: str
+    gauges: tuple[Gauge, ...]
+    zeroes: tuple[ZeroLine, ...]
+    limits: tuple[LimitLine, ...]
+    channels: tuple[str, ...]
+    readings: tuple[ReadingRow, ...]
+    rejected: tuple[tuple[str, str], ...]
+    streamed: str
+    notes: tuple[NoteLine, ...]
+    alarms: tuple[AlarmLine, ...]
+    verdicts: tuple[Verdict, ...]
+    figures: tuple[tuple[str, str], ...]
+    """Label → value of the 3-D figures (offsets, RP, AP), empty without x, y, z."""
+    sections: tuple[tuple[str, ...], ...]
+    """The procedure's own report blocks (linearity, relative accuracy), preformatted lines."""
+    hints: tuple[str, ...]
+    anchor: str
+    signature: str
+    problem: str
+    """Why there is no analysis (MISSING when there is one)."""
+    torn: str
+    sign_off: tuple[str, ...] = SIGN_OFF
+
+
+def decimals_for(resolution: float | None) -> int:
+    """Decimal places to show readings at a gauge resolution: its own digits plus two (a
+    mean or σ of readings at 0.0001 in carries 6 places); 6 without a resolution."""
+    if not resolution or resolution <= 0:
+        return 6
+    return max(0, -math.floor(math.log10(resolution) + 1e-9)) + 2
+
+
+def number(value: Any, places: int, *, signed: bool = False) -> str:
+    """A finite number at ``places`` decimals (with a sign when ``signed``); MISSING for None
+    or anything that is not a finite number."""
+    if value is None or isinstance(value, bool):
+        return MISSING
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        return MISSING
+    if not math.isfinite(value):
+        return MISSING
+    text = f"{value:+.{places}f}" if signed else f"{value:.{places}f}"
+    return "+" + text[1:] if text.startswith("-") and not text.strip("-0.") else text
+
+
+def index(value: Any) -> str:
+    """A capability index at two decimals, MISSING when undefined."""
+    return number(value, 2)
+
+
+def verdict_word(capable: bool | None) -> str:
+    """The verdict as a word: CAPABLE, NOT CAPABLE, or NO VERDICT (no limits, too few)."""
+    return {True: "CAPABLE", False: "NOT CAPABLE"}.get(capable, "NO VERDICT")  # type: ignore[arg-type]
+
+
+def parse_time(text: str) -> datetime | None:
+    """An event time (ISO-8601, ``Z``) as an aware datetime, None when it is not one."""
+    try:
+        return datetime.fromisoformat(str(text).replace("Z", "+00:00"))
+    except ValueError:
+        return None
+
+
+def duration_text(seconds: float) -> str:
+    """``1 h 02 min 05 s``, ``4 min 10 s`` or ``12 s``."""
+    seconds = max(0, round(seconds))
+    hours, rest = divmod(seconds, 3600)
+    minutes, secs = divmod(rest, 60)
+    if hours:
+        return f"{hours} h {minutes:02d} min {secs:02d} s"
+    if minutes:
+        return f"{minutes} min {secs:02d} s"
+    return f"{secs} s"
+
+
+def short_time(text: str) -> str:
+    """An event time to the second, ``2026-11-23 12:00:05Z``."""
+    moment = parse_time(text)
+    return MISSING if moment is None else moment.strftime("%Y-%m-%d %H:%M:%SZ")
+
+
+def signature_id(session: Any) -> str:
+    """The id of the key that signed the session's ``finish`` event, where one did: the
+    finish event's ``signature`` (its ``key_id``/``key``, or the text itself), else the header's
+    ``key_id`` / ``signing_key``. MISSING for an unsigned session."""
+    for event in reversed(session.events):
+        if event.get("type") == "finish":
+            signature = event.get("signature")
+            if isinstance(signature, Mapping):
+                key = signature.get("key_id") or signature.get("key")
+                if key:
+                    return str(key)
+            elif isinstance(signature, str) and signature:
+                return signature
+            break
+    for key in ("key_id", "signing_key", "public_key_id"):
+        if session.header.get(key):
+            return str(session.header[key])
+    return MISSING
+
+
+def _acknowledgements(session: Any) -> list[Mapping[str, Any]]:
+    return [e for e in session.events if e.get("type") in ("ack", "acknowledge")]
+
+
+def acknowledgement_of(alarm: Mapping[str, Any], acks: Sequence[Mapping[str, Any]]) -> str:
+    """The acknowledgement of ``alarm`` (an ``ack`` event naming its seq in ``alarm``, or its
+    channel and rule and one of its cycles), as ``cause; action (by, time)``; MISSING when
+    none. Sessions written before acknowledgements existed simply have none."""
+    cycles = set(alarm.get("cycles") or ())
+    for ack in acks:
+        named = ack.get("alarm")
+        matches = (
+            named == alarm.get("seq")
+            if named is not None
+            else (
+                ack.get("channel") == alarm.get("channel")
+                and ack.get("rule") == alarm.get("rule")
+                and bool(cycles & set(ack.get("cycles") or ()))
+            )
+        )
+        if matches:
+            parts = [str(ack.get(k)) for k in ("cause", "action", "text") if ack.get(k)]
+            who = ", ".join(x for x in (str(ack.get("by") or ""), short_time(ack["t"])) if x)
+            return f"{'; '.join(parts) or 'acknowledged'} ({who})"
+    return MISSING
+
+
+def _gauges(header: Mapping[str, Any], events: Sequence[Mapping[str, Any]]) -> tuple[Gauge, ...]:
+    instruments = header.get("instruments") or {}
+    serials_seen: dict[str, set[str]] = {}
+    for event in events:
+        if event.get("type") == "instrument":
+            for key in ("serial", "serial_number"):
+                if event.get(key):
+                    port = str(event.get("port") or "")
+                    serials_seen.setdefault(port, set()).add(str(event[key]))
+    gauges = []
+    for port in instruments.get("ports") or ():
+        if not isinstance(port, Mapping):
+            continue
+        url = str(port.get("url") or "")
+        mapping = port.get("map") or {}
+        serials = set(serials_seen.get(url, set()))
+        recorded = port.get("serials") or port.get("serial") or port.get("serial_number")
+        if isinstance(recorded, Mapping):
+            serials.update(f"{k}: {v}" for k, v in recorded.items())
+        elif recorded:
+            serials.add(str(recorded))
+        settings = port.get("settings") or {}
+        gauges.append(
+            Gauge(
+                port=url,
+                protocol=str(port.get("protocol") or ""),
+                channels=", ".join(f"{k}→{v}" for k, v in mapping.items()) or MISSING,
+                serials=", ".join(sorted(serials)) or "not reported by the gauge",
+                settings=" ".join(f"{k}={v}" for k, v in settings.items()) or MISSING,
+            )
+        )
+    return tuple(gauges)
+
+
+def _limits(header: Mapping[str, Any], places: int) -> tuple[LimitLine, ...]:
+    lines = []
+    for channel, spec in (header.get("limits") or {}).items():
+        if isinstance(spec, Mapping):
+            lines.append(
+                LimitLine(
+                    channel=str(channel),
+                    lsl=number(spec.get("lsl"), places, signed=True),
+                    usl=number(spec.get("usl"), places, signed=True),
+                    nominal=number(spec.get("nominal"), places, signed=True),
+                )
+            )
+    return tuple(lines)
+
+
+def _zeroes(session: Any, places: int) -> tuple[ZeroLine, ...]:
+    lines = []
+    for event in session.zeroes:
+        for channel, spec in (event.get("channels") or {}).items():
+            spec = spec if isinstance(spec, Mapping) else {}
+            offset = spec.get("offset")
+            lines.append(
+                ZeroLine(
+                    time=short_time(event["t"]),
+                    step=str(event.get("step") or ""),
+                    channel=str(channel),
+                    method=str(spec.get("method") or MISSING),
+                    offset=MISSING if offset is None else number(offset, places, signed=True),
+                )
+            )
+    return tuple(lines)
+
+
+def _readings(session: Any, places: int) -> tuple[ReadingRow, ...]:
+    rows = []
+    for cycle_number in sorted(session.cycles):
+        cycle = session.cycles[cycle_number]
+        reason = session.rejected.get(cycle_number)
+        rows.append(
+            ReadingRow(
+                cycle=str(cycle_number),
+                time=short_time(cycle.t),
+                placement=MISSING if cycle.placement is None else str(cycle.placement),
+                values=tuple(
+                    number(cycle.readings[c].value, places, signed=True)
+                    if c in cycle.readings
+                    else MISSING
+                    for c in session.channels
+                ),
+                status="ok" if reason is None else f"rejected: {reason}",
+            )
+        )
+    return tuple(rows)
+
+
+def _verdicts(analysed: AnalysedSession, places: int) -> tuple[Verdict, ...]:
+    if analysed.report is None or analysed.report.analysis is None:
+        return ()
+    verdicts = []
+    for key, channel in analysed.report.analysis.channels.items():
+        cap = channel.capability
+        verdicts.append(
+            Verdict(
+                channel=str(key),
+                name=str(channel.name),
+                n=str(channel.descriptive.n),
+                mean=number(channel.descriptive.mean, places, signed=True),
+                sd=number(channel.descriptive.sd, places),
+                cp=index(cap.cp),
+                cpk=index(cap.cpk),
+                cpk_lower=index(cap.cpk_lower),
+                word=verdict_word(cap.capable),
+                message=str(cap.message or ""),
+            )
+        )
+    return tuple(verdicts)
+
+
+def _figures(analysed: AnalysedSession, places: int) -> tuple[tuple[str, str], ...]:
+    if analysed.report is None or analysed.report.analysis is None:
+        return ()
+    spatial = analysed.report.analysis.spatial
+    if spatial is None:
+        return ()
+    figures = [
+        (f"Offset {axis} (mean − nominal)", number(value, places, signed=True))
+        for axis, value in spatial.offset.items()
+    ]
+    figures.append(("Total offset (APp)", number(spatial.total_offset, places)))
+    figures.append(("Pose repeatability RP = l̄ + 3·S_l", number(spatial.rp, places)))
+    return tuple(figures)
+
+
+def build_content(analysed: AnalysedSession) -> ReportContent:
+    """The report's content for an analysed session (see the module)."""
+    session = analysed.session
+    header = session.header
+    resolution = header.get("resolution")
+    places = decimals_for(resolution if isinstance(resolution, int | float) else None)
+    times = [t for t in (parse_time(e["t"]) for e in session.events) if t is not None]
+    duration = duration_text((times[-1] - times[0]).total_seconds()) if times else MISSING
+    procedure = header.get("procedure") or {}
+    acks = _acknowledgements(session)
+    report = analysed.report
+    streamed = MISSING
+    if session.samples:
+        points = sum(len(batch.values) for batch in session.samples)
+        strokes = len({batch.stroke for batch in session.samples})
+        streamed = (
+            f"{points} streamed points in {strokes} recorded strokes (every point is in the "
+            "session file; `station export --csv` writes them as stroke,s,h,v)"
+        )
+    alarms = tuple(
+        AlarmLine(
+            time=short_time(alarm["t"]),
+            channel=str(alarm.get("channel") or ""),
+            rule=str(alarm.get("rule") or ""),
+            cycles=", ".join(str(c) for c in alarm.get("cycles") or ()) or MISSING,
+            text=str(alarm.get("text") or ""),
+            acknowledged=acknowledgement_of(alarm, acks),
+        )
+        for alarm in session.alarms
+    )
+    return ReportContent(
+        title=report.title if report is not None else f"REPORT ON {session.path.name}",
+        file_name=session.path.name,
+        kind=analysed.kind,
+        session_id=session.session_id,
+        robot=session.robot,
+        operator=session.operator or "not given",
+        host=str(header.get("host") or MISSING),
+        procedure_id=session.procedure_id,
+        procedure_version=str(procedure.get("version") or MISSING),
+        procedure_sha256=str(procedure.get("sha256") or MISSING),
+        created=short_time(session.created),
+        ended=short_time(session.events[-1]["t"]) if session.events else MISSING,
+        duration=duration,
+        status=session.status,
+        unit=session.unit,
+        resolution=MISSING if not resolution else f"{resolution:g}",
+        rules=str(header.get("rules") or "report"),
+        threshold=f"{float(header.get('threshold') or 1.0):g}",
+        trigger=str((header.get("instruments") or {}).get("trigger") or MISSING),
+        gauges=_gauges(header, session.events),
+        zeroes=_zeroes(session, places),
+        limits=_limits(header, places),
+        channels=session.channels,
+        readings=_readings(session, places),
+        rejected=tuple((str(c), str(r)) for c, r in sorted(session.rejected.items())),
+        streamed=streamed,
+        notes=tuple(
+            NoteLine(
+                time=short_time(note["t"]),
+                by=str(note.get("by") or MISSING),
+                text=str(note.get("text") or ""),
+            )
+            for note in session.notes
+        ),
+        alarms=alarms,
+        verdicts=_verdicts(analysed, places),
+        figures=_figures(analysed, places),
+        sections=report.sections if report is not None else (),
+        hints=tuple(report.analysis.hints) if report is not None and report.analysis else (),
+        anchor=session.last_hash,
+        signature=signature_id(session),
+        problem=analysed.problem or MISSING,
+        torn=session.torn.message if session.torn is not None else MISSING,
+    )
