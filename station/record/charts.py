@@ -30,6 +30,7 @@ LIMIT_COLOUR = "#c0392b"
 CENTRE_COLOUR = "#2c3e50"
 POINT_COLOUR = "#1f77b4"
 ALARM_COLOUR = "#d62728"
+_METADATA_KEYS = ("Date", "Creator", "Format", "Type")
 
 
 @dataclass(frozen=True)
@@ -49,7 +50,8 @@ def _svg(figure: Any, salt: str) -> str:
 
     buffer = io.StringIO()
     with rc_context({**RC, "svg.hashsalt": salt}):
-        FigureCanvasSVG(figure).print_svg(buffer)
+        # No metadata block: no date (the same session gives the same page), no outside links.
+        FigureCanvasSVG(figure).print_svg(buffer, metadata=dict.fromkeys(_METADATA_KEYS))
     text = buffer.getvalue()
     start = text.find("<svg")
     return text[start:] if start >= 0 else text

@@ -1,0 +1,241 @@
+"""``station report``: one content model in txt, md and html; the HTML opened in a real headless
+Chromium, the Markdown in a standard parser."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+from html.parser import HTMLParser
+from pathlib import Path
+
+import pytest
+
+from station.cli import main
+from station.record.content import acknowledgement_of, build_content
+from station.record.render import render_report
+from station.record.source import analyse_session
+
+from .conftest import write_accuracy, write_linearity, write_repeatability
+
+CHROMIUM = shutil.which("chromium-headless-shell")
+BUILDERS = {
+    "repeatability": write_repeatability,
+    "relative_accuracy": write_accuracy,
+    "linearity": write_linearity,
+}
+# Charts each demo session draws: histogram + control chart per judged channel, then the 3-D
+# offsets and drift (x, y, z sessions) or one profile chart per indicator (linearity).
+EXPECTED_CHARTS = {"repeatability": 8, "relative_accuracy": 8, "linearity": 6}
+
+
+class _Text(HTMLParser):
+    """The visible text of an HTML page (style and SVG left out)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.parts: list[str] = []
+        self.skip = 0
+
+    def handle_starttag(self, tag, attrs):
+        if tag in ("style", "svg", "script"):
+            self.skip += 1
+
+    def handle_endtag(self, tag):
+        if tag in ("style", "svg", "script"):
+            self.skip -= 1
+
+    def handle_data(self, data):
+        if not self.skip:
+            self.parts.append(data)
+
+
+def visible_text(html: str) -> str:
+    parser = _Text()
+    parser.feed(html)
+    return " ".join(" ".join(parser.parts).split())
+
+
+def markdown_html(markdown: str) -> str:
+    from markdown_it import MarkdownIt
+
+    return MarkdownIt("commonmark").enable("table").render(markdown)
+
+
+def run_station(*args: str) -> int:
+    return main(list(args))
+
+
+def chromium(url: str, *extra: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [
+            CHROMIUM,
+            "--no-sandbox",
+            "--disable-gpu",
+            "--hide-scrollbars",
+            "--enable-logging=stderr",
+            "--v=0",
+            *extra,
+            url,
+        ],
+        capture_output=True,
+        text=True,
+        timeout=90,
+    )
+
+
+def console_messages(stderr: str) -> list[str]:
+    return [line for line in stderr.splitlines() if ":CONSOLE" in line]
+
+
+def bluish_pixels(png: Path) -> int:
+    """Pixels of the charts' blue (points, bars): tables and text have none."""
+    from matplotlib.image import imread
+
+    image = imread(png)
+    red, green, blue = image[..., 0], image[..., 1], image[..., 2]
+    return int(((blue - red > 0.25) & (blue > 0.5) & (green < 0.8)).sum())
+
+
+@pytest.fixture(scope="module")
+def artefacts(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Where the screenshots go (kept with pytest's temporary folders for a look after)."""
+    return tmp_path_factory.mktemp("report-artefacts")
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="chromium-headless-shell is not installed")
+@pytest.mark.parametrize("kind", list(BUILDERS))
+def test_html_report_opens_in_chromium_with_its_charts(kind, sessions, artefacts):
+    path = BUILDERS[kind](sessions)
+    page = sessions / f"{kind}.html"
+    assert run_station("report", str(path), "--format", "html", "-o", str(page)) == 0
+    html = page.read_text(encoding="utf-8")
+    assert html.count("<svg") == EXPECTED_CHARTS[kind]
+    assert "http://" not in html.replace("http://www.w3.org/", "")  # self-contained
+
+    shot = artefacts / f"{kind}.png"
+    result = chromium(page.as_uri(), f"--screenshot={shot}", "--window-size=1000,5000")
+    assert shot.exists(), result.stderr
+    assert console_messages(result.stderr) == []
+    assert bluish_pixels(shot) > 5000, f"no charts visible in {shot}"
+
+    dom = chromium(page.as_uri(), "--dump-dom").stdout
+    assert dom.count('class="chart"') == EXPECTED_CHARTS[kind]
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="chromium-headless-shell is not installed")
+def test_chromium_check_sees_a_page_that_reaches_outside(tmp_path):
+    """The console check above can fail: a page loading an outside image is reported."""
+    page = tmp_path / "outside.html"
+    template = render_report(write_repeatability(tmp_path / "s", cycles=5), "html")
+    page.write_text(template.replace("</body>", '<img src="http://192.0.2.1/x.png"></body>'))
+    result = chromium(page.as_uri(), "--dump-dom")
+    assert console_messages(result.stderr)
+
+
+def facts(content) -> list[str]:
+    """What every format must say, as the content model formats it."""
+    said = [
+        content.robot,
+        content.operator,
+        content.procedure_id,
+        content.procedure_version,
+        content.procedure_sha256,
+        content.session_id,
+        content.anchor,
+        content.created,
+        content.duration,
+        f"{len(content.readings)} cycles, {len(content.rejected)} rejected",
+    ]
+    for verdict in content.verdicts:
+        said += [verdict.name, verdict.word, verdict.mean, verdict.sd, verdict.cpk]
+        said.append(verdict.cpk_lower)
+    for row in content.readings:
+        said += [*row.values, row.status]
+    said += [f"Rejected cycle {cycle}: {reason}" for cycle, reason in content.rejected]
+    said += [note.text for note in content.notes]
+    said += [alarm.text for alarm in content.alarms]
+    said += [value for _, value in content.figures]
+    said += [zero.offset for zero in content.zeroes]
+    said += [limit.usl for limit in content.limits]
+    said += [gauge.port for gauge in content.gauges]
+    said += list(content.hints)
+    said += [line.strip() for section in content.sections for line in section if line.strip()]
+    return said
+
+
+@pytest.mark.parametrize("kind", list(BUILDERS))
+def test_txt_md_html_say_the_same(kind, sessions):
+    path = BUILDERS[kind](sessions)
+    content = build_content(analyse_session(path))
+    texts = {
+        "txt": " ".join(render_report(path, "txt").split()),
+        "md": visible_text(markdown_html(render_report(path, "md"))),
+        "html": visible_text(render_report(path, "html")),
+    }
+    expected = [" ".join(fact.split()) for fact in facts(content)]
+    assert len(expected) > 40
+    for fmt, text in texts.items():
+        missing = [fact for fact in expected if fact not in text]
+        assert missing == [], f"{fmt} lacks {missing[:5]}"
+    # The same number of rejected readings in each.
+    assert len({text.count("rejected: ") for text in texts.values()}) == 1
+
+
+def test_markdown_renders_in_a_standard_parser(sessions):
+    path = write_repeatability(sessions, robot="<script>alert(1)</script> *bold* | pipe")
+    html = markdown_html(render_report(path, "md"))
+    assert html.count("<table>") >= 4  # facts, limits, readings, alarms, verdicts
+    assert re.search(r"<h1>BASIC STATISTICS", html)
+    assert "<script>" not in html
+    assert "&lt;script&gt;alert(1)&lt;/script&gt; *bold* | pipe" in html
+    assert "<em>" not in html.split("</table>")[0]  # the name is no emphasis
+
+
+def test_html_keeps_a_hostile_robot_name_as_text(sessions):
+    path = write_repeatability(sessions, robot='<script>alert("x")</script>', operator="a&b")
+    html = render_report(path, "html")
+    assert "<script>" not in html
+    assert "&lt;script&gt;alert(&#34;x&#34;)&lt;/script&gt;" in html
+    assert "a&amp;b" in html
+
+
+def test_control_characters_are_made_visible(sessions):
+    path = write_repeatability(sessions, note="red \x1b[31mALARM\x1b[0m \u202eevil")
+    for fmt in ("txt", "md", "html"):
+        text = render_report(path, fmt)
+        assert "\x1b" not in text and "\u202e" not in text
+        assert "\\x1b[31mALARM" in text.replace("\\\\", "\\").replace("\\[", "[")
+        assert "\\u202eevil" in text
+
+
+def test_report_command_writes_refuses_and_chooses_the_format(sessions, capsys):
+    path = write_repeatability(sessions, cycles=6)
+    out = sessions.parent / "report.md"
+    assert run_station("report", str(path), "-o", str(out)) == 0
+    assert out.read_text().startswith("# BASIC STATISTICS")  # the suffix chose md
+    assert run_station("report", str(path), "-o", str(out)) == 2
+    assert "exists; pass --force" in capsys.readouterr().err
+    assert run_station("report", str(path), "-o", str(path), "--force") == 2
+    assert "is the session file itself" in capsys.readouterr().err
+    assert run_station("report", str(path), "--format", "txt") == 0
+    assert capsys.readouterr().out == render_report(path, "txt")
+    assert run_station("report", str(sessions / "missing.jsonl")) == 2
+
+
+def test_a_session_without_readings_still_reports(sessions):
+    path = write_repeatability(sessions, cycles=0, reject=None, alarm=False)
+    for fmt in ("txt", "md", "html"):
+        assert "No verdict: the session has no accepted readings yet" in render_report(path, fmt)
+
+
+def test_acknowledgements_are_matched_to_their_alarm():
+    alarm = {"seq": 40, "channel": "x", "rule": "report-1", "cycles": [5], "t": "x"}
+    by_seq = {"type": "ack", "alarm": 40, "cause": "fixture moved", "by": "ana"}
+    by_seq["t"] = "2026-11-23T12:00:05.000000Z"
+    by_rule = {"type": "ack", "channel": "x", "rule": "report-1", "cycles": [5, 6]}
+    by_rule |= {"cause": "gauge", "action": "reseated", "t": "2026-11-23T12:00:06.000000Z"}
+    other = {**by_rule, "rule": "report-4"}
+    assert acknowledgement_of(alarm, [by_seq]) == "fixture moved (ana, 2026-11-23 12:00:05Z)"
+    assert acknowledgement_of(alarm, [other, by_rule]).startswith("gauge; reseated")
+    assert acknowledgement_of(alarm, [other]) == "—"
