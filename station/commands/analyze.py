@@ -149,7 +149,14 @@ def load_source(path: Path) -> Any:
 
     table = read_table(path)
     cycles = None if table.cycles is None else dict.fromkeys(table.channels, table.cycles)
-    return TableSource(channels=table.channels, cycles=cycles, table=table)
+    if table.channel_cycles is not None:  # a tidy table: its own cycle numbers per channel
+        cycles = dict(table.channel_cycles)
+    return TableSource(
+        channels=table.channels,
+        cycles=cycles,
+        table=table,
+        excluded_cycles=table.excluded_cycles,
+    )
 
 
 @dataclass(frozen=True)
@@ -180,6 +187,9 @@ def table_accuracy_inputs(table: Any) -> tuple[Any, dict[str, Any], dict[int, tu
     """Placements, errors x, y, z and pendant coordinates of a relative-accuracy CSV."""
     from station.session.tables import require_columns
 
+    if table.placements is not None and "placement" not in {n.lower() for n in table.channels}:
+        # A tidy table keeps the placement beside each cycle, not as a channel.
+        table = replace(table, channels={**table.channels, "placement": table.placements})
     columns = require_columns(table, ACCURACY_COLUMNS, "a relative-accuracy table")
     pendant: dict[int, tuple[float, ...]] = {}
     lowered = {name.lower() for name in table.channels}
@@ -248,7 +258,7 @@ def run(args: argparse.Namespace) -> int:
             config=config,
             channels=channels,
             cycles=source.cycles,
-            excluded_cycles=(),
+            excluded_cycles=source.excluded_cycles,
             profiles=lambda: table_linearity_profiles(table),
             accuracy_inputs=lambda: table_accuracy_inputs(table),
             tolerance=tolerance,

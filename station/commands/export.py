@@ -15,9 +15,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "export",
         help="export a session's readings as CSV",
         description=(
-            "Write a session's cycles as tidy CSV: cycle, channel, value, unit, status (ok or "
-            "'rejected: <reason>'), time, then raw value, zero offset and placement. Rejected "
-            "cycles stay in the export, marked. The session file is opened read-only."
+            "Write a session's readings as CSV. Tidy (repeatability's default): cycle, channel, "
+            "value, unit, status (ok or 'rejected: <reason>'), time, then raw value, zero offset "
+            "and placement; rejected cycles stay in the export, marked. Wide (the default for "
+            "linearity and relative accuracy): the table `station analyze --procedure KIND` "
+            "reads, accepted readings only, rejected cycles named in '#' lines. `station "
+            "analyze` reads both layouts. The session file is opened read-only."
         ),
     )
     parser.add_argument("file", metavar="FILE", help="the session file (.jsonl)")
@@ -27,6 +30,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "-o", "--output", metavar="OUT", help="write to OUT instead of standard output"
     )
+    parser.add_argument(
+        "--layout",
+        choices=("auto", "tidy", "wide"),
+        default="auto",
+        help="tidy: one row per cycle and channel; wide: the table `station analyze` reads for "
+        "the session's procedure (linearity: stroke,s,h,v; relative accuracy: "
+        "cycle,placement,x,y,z,px,py,pz; else cycle,x,y,z of the accepted cycles); auto "
+        "(default): wide for linearity and relative accuracy, tidy otherwise",
+    )
     parser.add_argument("--force", action="store_true", help="overwrite OUT when it exists")
     parser.set_defaults(func=run)
 
@@ -34,21 +46,27 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Export; StationError for a missing session or an existing OUT without --force."""
     from station.session.durable import replace_durably
-    from station.session.export import export_csv
+    from station.session.export import export_table
     from station.session.model import load_session
+    from station.session.report import session_analysis
 
     session = load_session(args.file, recover=False)
     if session.torn is not None:
         print(f"station: note: {session.torn.message}", file=sys.stderr)
+    kind = session_analysis(session)
+    layout = args.layout
+    if layout == "auto":
+        layout = "wide" if kind in ("linearity", "relative_accuracy") else "tidy"
+
     if not args.output:
-        export_csv(session, sys.stdout)
+        export_table(session, sys.stdout, layout, kind)
         return 0
     out = Path(args.output)
     if out.exists() and not args.force:
         raise StationError(f"{out} exists; pass --force to overwrite it or choose another name")
     try:
         # Synced before the rename and the folder after: OUT is whole or absent after a crash.
-        rows = replace_durably(out, lambda handle: export_csv(session, handle))
+        rows = replace_durably(out, lambda handle: export_table(session, handle, layout, kind))
     except OSError as error:
         raise StationError(f"cannot write {out}: {error.strerror}") from None
     print(f"wrote {rows} rows to {out}", file=sys.stderr)
