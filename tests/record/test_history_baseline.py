@@ -1,0 +1,129 @@
+"""``station history`` over simulated sessions with a growing bias, and ``station baseline``."""
+
+from __future__ import annotations
+
+import json
+from datetime import UTC, datetime, timedelta
+
+import pytest
+
+from station.cli import main
+from station.record.baseline import baseline_for, baseline_path, clear_baseline, store_baseline
+from station.record.history import robot_history, text_chart
+
+from .conftest import write_repeatability
+
+START = datetime(2026, 1, 5, 9, 0, tzinfo=UTC)
+STEP_DAYS = 30
+BIAS_STEP = 0.0001  # x drifts 0.0001 in per 30 days: the USL +0.001 is reached on day 300
+
+
+def five_sessions(folder, robot="KSC-7"):
+    paths = []
+    for index in range(5):
+        paths.append(
+            write_repeatability(
+                folder,
+                robot=robot,
+                seed=100 + index,
+                bias={"x": BIAS_STEP * index},
+                created=START + timedelta(days=STEP_DAYS * index),
+                reject=None,
+                alarm=False,
+            )
+        )
+    # Another robot's session in the same folder is not part of the history.
+    write_repeatability(folder, robot="other", seed=9, created=START)
+    return paths
+
+
+def test_history_shows_the_wear_trend_and_its_crossing_date(sessions, capsys):
+    paths = five_sessions(sessions)
+    history = robot_history(sessions, "KSC-7")
+    assert [e.path for e in history.entries] == paths
+    trends = {t.channel: t for t in history.trends}
+    x = trends["x"]
+    assert x.significant and x.ci_low > 0
+    assert x.slope_per_day * STEP_DAYS == pytest.approx(BIAS_STEP, rel=0.35)
+    expected = START + timedelta(days=300)
+    crossing = datetime.fromisoformat(x.crossing).replace(tzinfo=UTC)
+    assert abs((crossing - expected).days) <= 60
+    assert x.limit == pytest.approx(0.001) and x.limit_name == "USL"
+    for axis in ("y", "z"):
+        assert not trends[axis].significant and trends[axis].crossing is None
+
+    assert main(["history", "KSC-7", "--sessions", str(sessions)]) == 0
+    out = capsys.readouterr().out
+    assert "History of robot KSC-7 (5 sessions)" in out
+    assert f"reaches the USL +0.001 on {x.crossing}" in out
+    assert "RP over the sessions" in out and "Cpk of x over the sessions" in out
+    assert "y: no significant trend" in out
+
+    assert main(["history", "KSC-7", "--sessions", str(sessions), "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    assert [s["file"] for s in document["sessions"]] == [p.name for p in paths]
+    assert document["trends"][0]["crossing"] == x.crossing
+    offsets = [s["channels"]["x"]["offset"] for s in document["sessions"]]
+    assert offsets == sorted(offsets) or offsets[-1] > offsets[0] + 0.0003
+
+
+def test_history_of_an_unknown_robot_says_so(sessions, capsys):
+    write_repeatability(sessions, robot="KSC-7")
+    assert main(["history", "KSC-8", "--sessions", str(sessions)]) == 2
+    assert "no session of robot 'KSC-8'" in capsys.readouterr().err
+
+
+def test_text_chart_places_the_extremes_on_the_top_and_bottom_rows():
+    lines = text_chart([1.0, 2.0, None, 3.0], height=4)
+    assert lines[0].endswith("*") and lines[0].strip().startswith("3")
+    assert "*" in lines[3] and lines[3].strip().startswith("1")
+    assert len(lines) == 5
+
+
+def test_baseline_is_stored_loaded_marked_and_cleared(sessions, capsys):
+    paths = five_sessions(sessions)
+    assert baseline_for("KSC-7") is None
+    assert main(["baseline", "KSC-7", str(paths[1])]) == 0
+    record = baseline_for("KSC-7")
+    assert record is not None
+    assert set(record["channels"]) == {"x", "y", "z"}
+    x = record["channels"]["x"]
+    assert x["lcl"] < x["center"] < x["ucl"] and x["mr_ucl"] > 0
+    assert record["anchor"] in paths[1].read_text()
+    assert baseline_path("KSC-7").parent.parent.parent == sessions.parent / "data"
+
+    history = robot_history(sessions, "KSC-7")
+    assert [e.baseline for e in history.entries] == [False, True, False, False, False]
+    capsys.readouterr()
+    assert main(["history", "KSC-7", "--sessions", str(sessions)]) == 0
+    assert capsys.readouterr().out.count("[baseline]") == 1
+
+    assert main(["baseline", "KSC-7"]) == 0
+    assert record["session"] in capsys.readouterr().out
+    assert main(["baseline", "KSC-7", "--clear"]) == 0
+    assert baseline_for("KSC-7") is None
+    assert not clear_baseline("KSC-7")
+
+
+def test_a_baseline_must_be_finished_capable_and_of_that_robot(sessions):
+    capable = write_repeatability(sessions, robot="R1")
+    from station.errors import StationError
+
+    with pytest.raises(StationError, match="not 'R2'"):
+        store_baseline("R2", capable)
+    wide = write_repeatability(sessions, robot="R1", seed=4, noise={"y": 0.0008})
+    with pytest.raises(StationError, match="not capable on y"):
+        store_baseline("R1", wide)
+    unfinished = sessions / "unfinished.jsonl"
+    lines = capable.read_bytes().splitlines(keepends=True)
+    unfinished.write_bytes(b"".join(lines[:-1]))  # without its finish event
+    with pytest.raises(StationError, match="not finished"):
+        store_baseline("R1", unfinished)
+    assert baseline_for("R1") is None
+
+
+def test_a_damaged_baseline_is_named_not_trusted(sessions, capsys):
+    store_baseline("R1", write_repeatability(sessions, robot="R1"))
+    baseline_path("R1").write_text("{not json")
+    assert main(["baseline", "R1"]) == 2
+    assert "cannot be read" in capsys.readouterr().err
