@@ -66,13 +66,14 @@ def write_repeatability(
     alarm: bool = True,
     operator: str = "ana",
     resolution: float = 0.0001,
+    unit: str | None = None,
 ) -> Path:
     """A finished repeatability session of ``cycles`` reading sets of x, y, z (rounded to the
     resolution), with a reject, a note and a recorded alarm."""
     rng = np.random.default_rng(seed)
     bias = {axis: 0.0 for axis in AXES} | (bias or {})
     noise = {axis: 0.0002 for axis in AXES} | (noise or {})
-    header = header_fields("repeatability", robot=robot, operator=operator)
+    header = header_fields("repeatability", robot=robot, operator=operator, unit=unit)
     with SessionWriter.create(folder, header, now=created) as writer:
         writer.append("instrument", port="socket://127.0.0.1:7001", state="connected")
         writer.append("step", step="fixture", action="confirmed", by="operator")
