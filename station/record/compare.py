@@ -153,9 +153,9 @@ def compare_axis(
     suffix = f" {unit}" if unit else ""
     level = f"{confidence:.0%}"
     if moved:
-        low, high = f"{shift - margin:+.{places}f}", f"{shift + margin:+.{places}f}"
+        from_text, to_text = f"{shift - margin:+.{places}f}", f"{shift + margin:+.{places}f}"
         first = (
-            f"{channel} moved {shift:+.{places}f}{suffix} ({level} CI {low} to {high}), "
+            f"{channel} moved {shift:+.{places}f}{suffix} ({level} CI {from_text} to {to_text}), "
             f"{_p_text(p)}: the change between the sessions moved {channel}"
         )
     else:
