@@ -86,8 +86,9 @@ def histogram_chart(name: str, channel: Any, unit: str) -> Any:
     return figure
 
 
-def control_chart(name: str, channel: Any) -> Any:
-    """The location chart: points by cycle, centre line, control limits, alarms in red."""
+def control_chart(name: str, channel: Any, xlabel: str = "cycle") -> Any:
+    """The location chart: points by cycle (or stroke), centre line, control limits, alarms
+    circled in red."""
     import numpy as np
 
     chart = channel.chart
@@ -119,7 +120,7 @@ def control_chart(name: str, channel: Any) -> Any:
             zorder=3,
         )
     axes.set_title(f"Control chart ({chart.type}) of {name}")
-    axes.set_xlabel("cycle")
+    axes.set_xlabel(xlabel)
     axes.legend(loc="upper right", fontsize=7)
     return figure
 

@@ -239,3 +239,48 @@ def test_acknowledgements_are_matched_to_their_alarm():
     assert acknowledgement_of(alarm, [by_seq]) == "fixture moved (ana, 2026-11-23 12:00:05Z)"
     assert acknowledgement_of(alarm, [other, by_rule]).startswith("gauge; reseated")
     assert acknowledgement_of(alarm, [other]) == "—"
+
+
+def test_report_of_a_real_headless_capture(tmp_path):
+    """A session recorded by ``station capture`` against ``station simulate`` (both real
+    processes on a real pty) reports the same facts in every format, its port among them."""
+    import os
+    import signal
+    import sys
+
+    station = [sys.executable, "-m", "station"]
+    environment = {**os.environ, "STATION_PROCEDURES": ""}
+    simulate = subprocess.Popen(
+        [*station, "simulate", "--protocol", "mitutoyo", "--unit", "in", "--seed", "3"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=environment,
+    )
+    try:
+        url = simulate.stdout.readline().strip()
+        assert url, simulate.stderr.read()
+        capture = subprocess.run(
+            [
+                *station, "capture", "--procedure", "repeatability", "--port", url,
+                "--protocol", "mitutoyo", "--robot", "R1", "--operator", "ana",
+                "--sessions", str(tmp_path / "sessions"), "--cycles", "25",
+            ],
+            capture_output=True, text=True, env=environment, timeout=120,
+        )  # fmt: skip
+        assert capture.returncode == 0, capture.stderr
+    finally:
+        simulate.send_signal(signal.SIGTERM)
+        simulate.communicate(timeout=10)
+    (path,) = (tmp_path / "sessions").glob("*.jsonl")
+    content = build_content(analyse_session(path))
+    assert content.gauges[0].port == url and len(content.readings) == 25
+    assert {zero.channel for zero in content.zeroes} == {"x", "y", "z"}
+    texts = {
+        "txt": " ".join(render_report(path, "txt").split()),
+        "md": visible_text(markdown_html(render_report(path, "md"))),
+        "html": visible_text(render_report(path, "html")),
+    }
+    for fmt, text in texts.items():
+        missing = [f for f in (" ".join(f.split()) for f in facts(content)) if f not in text]
+        assert missing == [], f"{fmt} lacks {missing[:5]}"
