@@ -100,6 +100,8 @@ class Verdict:
     cp: str
     cpk: str
     cpk_lower: str
+    confidence: str
+    """The one-sided confidence level of ``cpk_lower`` (``95%``)."""
     word: str
     message: str
 
@@ -361,6 +363,7 @@ def _verdicts(analysed: AnalysedSession, places: int) -> tuple[Verdict, ...]:
                 cp=index(cap.cp),
                 cpk=index(cap.cpk),
                 cpk_lower=index(cap.cpk_lower),
+                confidence=f"{cap.confidence:.0%}",
                 word=verdict_word(cap.capable),
                 message=str(cap.message or ""),
             )

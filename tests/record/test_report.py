@@ -149,7 +149,7 @@ def facts(content) -> list[str]:
     ]
     for verdict in content.verdicts:
         said += [verdict.name, verdict.word, verdict.mean, verdict.sd, verdict.cpk]
-        said.append(verdict.cpk_lower)
+        said += [verdict.cpk_lower, verdict.confidence]
     for row in content.readings:
         said += [*row.values, row.status]
     said += [f"Rejected cycle {cycle}: {reason}" for cycle, reason in content.rejected]
