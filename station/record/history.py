@@ -52,6 +52,7 @@ class HistoryEntry:
     anchor: str
     baseline: bool = False
     problem: str | None = None
+    unit: str = ""
 
 
 @dataclass(frozen=True)
@@ -124,6 +125,7 @@ def _entry(path: Path, baseline_session: str | None) -> HistoryEntry:
         anchor=session.last_hash,
         baseline=baseline_session is not None and session.session_id == baseline_session,
         problem=analysed.problem,
+        unit=session.unit,
     )
 
 
@@ -236,11 +238,7 @@ def robot_history(folder: str | Path, robot: str) -> RobotHistory:
             entries.append(_entry(summary.path, baseline_session))
         except StationError:
             continue
-    unit = ""
-    if entries:
-        from station.session.model import load_session
-
-        unit = load_session(entries[-1].path, recover=False).unit
+    unit = entries[-1].unit if entries else ""
     return RobotHistory(
         robot=robot,
         folder=folder,
