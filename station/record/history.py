@@ -161,8 +161,9 @@ def _trends(entries: Sequence[HistoryEntry], unit: str) -> tuple[Trend, ...]:
     analysed = [e for e in entries if e.channels and parse_time(e.created) is not None]
     if not analysed:
         return ()
-    procedure = analysed[-1].procedure
-    same = [e for e in analysed if e.procedure == procedure]
+    procedure, unit_of_latest = analysed[-1].procedure, analysed[-1].unit
+    # Means in different units (or of different procedures) cannot share one line.
+    same = [e for e in analysed if e.procedure == procedure and e.unit == unit_of_latest]
     first = parse_time(same[0].created)
     assert first is not None
     trends = []
