@@ -18,7 +18,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "last line hash). Text charts of RP and Cpk over time follow, then the wear trend: "
             "per channel the slope of the session means against the date with its 95% "
             "confidence interval and, where it is significant, the date at which the trend "
-            "line would reach a limit. Sessions of the latest session's procedure are trended. "
+            "line would reach a limit. Sessions of the latest session's procedure and unit are "
+            "trended. "
             "The robot's baseline session is marked."
         ),
     )

@@ -5,7 +5,8 @@ The wear trend is, per channel, the least-squares line of the session means agai
 (the report's periodic testing, §1.3: a robot that wears drifts off its nominal). Its slope is
 given with a confidence interval (Student's t on n − 2 degrees of freedom); where the slope is
 significant (the interval excludes 0) and heads for a limit, the date at which the line would
-reach that limit is given too. Only sessions of one procedure are trended together.
+reach that limit is given too. Only sessions of the latest session's procedure and unit are
+trended together.
 """
 
 from __future__ import annotations
