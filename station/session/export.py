@@ -38,7 +38,9 @@ def export_csv(session: Session, out: TextIO) -> int:
     for number in sorted(session.cycles):
         cycle = session.cycles[number]
         reason = session.rejected.get(number)
-        status = "ok" if reason is None else f"rejected: {reason}"
+        # One line per row: a reason typed with a line break must not split the row for a
+        # reader that takes the file line by line (``station analyze`` does).
+        status = "ok" if reason is None else f"rejected: {_one_line(reason)}"
         for channel in (*session.channels, *sorted(set(cycle.readings) - set(session.channels))):
             reading = cycle.readings.get(channel)
             if reading is None:

@@ -95,3 +95,15 @@ def test_a_tidy_table_with_every_row_rejected_is_refused(tmp_path: Path, capsys)
     table.write_text("cycle,channel,value,status\n1,x,0.1,rejected: bumped\n")
     assert main(["analyze", str(table)]) == 2
     assert "every reading in the table is rejected" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("layout", ["tidy", "wide"])
+def test_a_reason_with_line_breaks_stays_on_its_line(layout, sessions, capsys):
+    reason = "bumped\n99,x,5.0,in,ok\r\n# not a comment"
+    session = write_repeatability(sessions, reject=(4, reason))
+    table = sessions.parent / f"{layout}.csv"
+    assert main(["export", str(session), "--csv", "--layout", layout, "-o", str(table)]) == 0
+    assert "bumped 99,x,5.0,in,ok # not a comment" in table.read_text()
+    from_session = analyze_json(capsys, str(session))
+    assert analyze_json(capsys, str(table), *SETTINGS["repeatability"]) == from_session
+    assert from_session["excluded_cycles"] == [4]
