@@ -188,8 +188,9 @@ def linearity_chart(channel: str, analysed: AnalysedSession, unit: str) -> Any:
 
 
 def drift_chart(analysed: AnalysedSession, unit: str) -> Any | None:
-    """Each channel's accepted readings against the minutes since the first, with its
-    least-squares trend; None with fewer than three timed cycles."""
+    """Each channel's accepted readings against the time since the first (seconds, minutes or
+    hours, as the session's length suits), with its least-squares trend; None with fewer than
+    three timed cycles."""
     import numpy as np
 
     session = analysed.session
@@ -199,34 +200,36 @@ def drift_chart(analysed: AnalysedSession, unit: str) -> Any | None:
     first = parse_time(session.cycles[numbers[0]].t)
     if first is None:
         return None
-    figure = _figure()
-    axes = figure.add_subplot()
-    drawn = False
+    series = {}
     for channel in session.channels:
         pairs = []
         for n in numbers:
             cycle = session.cycles[n]
             moment = parse_time(cycle.t)
             if channel in cycle.readings and moment is not None:
-                pairs.append(((moment - first).total_seconds() / 60, cycle.readings[channel].value))
-        if len(pairs) < 3:
-            continue
-        minutes, values = (np.asarray(v, dtype=float) for v in zip(*pairs, strict=True))
-        (line,) = axes.plot(minutes, values, marker=".", linewidth=0.8, label=channel)
-        if np.ptp(minutes) > 0:
-            slope, intercept = np.polyfit(minutes, values, 1)
+                pairs.append(((moment - first).total_seconds(), cycle.readings[channel].value))
+        if len(pairs) >= 3:
+            series[channel] = tuple(np.asarray(v, dtype=float) for v in zip(*pairs, strict=True))
+    if not series:
+        return None
+    span = max(float(np.ptp(seconds)) for seconds, _ in series.values())
+    scale, label = (1.0, "s") if span < 120 else (60.0, "min") if span < 7200 else (3600.0, "h")
+    figure = _figure()
+    axes = figure.add_subplot()
+    for channel, (seconds, values) in series.items():
+        elapsed = seconds / scale
+        (line,) = axes.plot(elapsed, values, marker=".", linewidth=0.8, label=channel)
+        if np.ptp(elapsed) > 0:
+            slope, intercept = np.polyfit(elapsed, values, 1)
             axes.plot(
-                minutes,
-                intercept + slope * minutes,
+                elapsed,
+                intercept + slope * elapsed,
                 color=line.get_color(),
                 linestyle="--",
-                label=f"{channel} trend {slope:+.3g}/min",
+                label=f"{channel} trend {slope:+.3g} {unit}/{label}".replace("  ", " "),
             )
-        drawn = True
-    if not drawn:
-        return None
     axes.set_title("Readings over time (drift)")
-    axes.set_xlabel("minutes since the first cycle")
+    axes.set_xlabel(f"time since the first cycle ({label})")
     axes.set_ylabel(f"reading ({unit})" if unit else "reading")
     axes.legend(loc="upper right", fontsize=7)
     return figure

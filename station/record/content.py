@@ -316,7 +316,12 @@ def _zeroes(session: Any, places: int) -> tuple[ZeroLine, ...]:
             lines.append(
                 ZeroLine(
                     time=short_time(event["t"]),
-                    step=str(event.get("step") or ""),
+                    step=str(event.get("step") or "")
+                    + (
+                        f" (placement {event['placement']})"
+                        if event.get("placement") is not None
+                        else ""
+                    ),
                     channel=str(channel),
                     method=str(spec.get("method") or MISSING),
                     offset=MISSING if offset is None else number(offset, places, signed=True),
