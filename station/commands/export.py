@@ -45,10 +45,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Export; StationError for a missing session or an existing OUT without --force."""
+    from station.record.export import export_table
     from station.session.durable import replace_durably
-    from station.session.export import export_table
     from station.session.model import load_session
-    from station.session.report import session_analysis
+    from station.verdicts import session_analysis
 
     session = load_session(args.file, recover=False)
     if session.torn is not None:

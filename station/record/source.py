@@ -2,8 +2,8 @@
 
 Reports, history, comparison and baselines read a session's analysis only through
 :func:`analyse_session`. It calls the domain function that turns a session into its analysis and
-JSON document (today :func:`station.session.report.report_session`); when that moves under the
-analysis-kind registry, only this function changes.
+JSON document through the analysis-kind registry (:func:`station.verdicts.report_session`); if
+that changes, only this function changes.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from station.errors import StationError
 if TYPE_CHECKING:
     from station.analysis.linearity import StrokeProfile
     from station.session.model import Session
-    from station.session.report import SessionReport
+    from station.verdicts import SessionReport
 
 
 @dataclass(frozen=True)
@@ -48,11 +48,7 @@ def analyse_session(path: str | Path) -> AnalysedSession:
     analyse yet is returned with ``problem`` set instead.
     """
     from station.session.model import load_session
-    from station.session.report import (
-        report_session,
-        session_linearity_profiles,
-        session_source,
-    )
+    from station.verdicts import report_session, session_source, session_stroke_profiles
 
     path = Path(path)
     session = load_session(path, recover=False)
@@ -67,7 +63,7 @@ def analyse_session(path: str | Path) -> AnalysedSession:
         )
     profiles: tuple[StrokeProfile, ...] = ()
     if report.kind == "linearity":
-        profiles = tuple(session_linearity_profiles(session))
+        profiles = tuple(session_stroke_profiles(session))
     return AnalysedSession(
         path=path,
         session=session,

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from station.procedures import discover_procedures
-from station.runner import PortSetup, SessionSetup
+from station.run import PortSetup, SessionSetup
 from station.session.journal import SessionWriter
 
 AXES = ("x", "y", "z")
