@@ -18,8 +18,10 @@ from datetime import datetime
 from typing import Any
 
 from station.record.source import AnalysedSession
+from station.text import NOT_AVAILABLE, format_value, verdict_word
 
-MISSING = "—"
+MISSING = NOT_AVAILABLE
+"""What an absent or undefined figure shows (the same ``-`` as every screen and command)."""
 SIGN_OFF = ("Tested by", "Reviewed by")
 
 
@@ -136,6 +138,7 @@ class ReportContent:
     readings: tuple[ReadingRow, ...]
     rejected: tuple[tuple[str, str], ...]
     streamed: str
+    """How many points a session streamed ("" when it streamed none)."""
     notes: tuple[NoteLine, ...]
     alarms: tuple[AlarmLine, ...]
     verdicts: tuple[Verdict, ...]
@@ -147,8 +150,9 @@ class ReportContent:
     anchor: str
     signature: str
     problem: str
-    """Why there is no analysis (MISSING when there is one)."""
+    """Why there is no analysis ("" when there is one)."""
     torn: str
+    """The torn tail's message ("" for an intact file)."""
     sign_off: tuple[str, ...] = SIGN_OFF
 
 
@@ -178,11 +182,6 @@ def number(value: Any, places: int, *, signed: bool = False) -> str:
 def index(value: Any) -> str:
     """A capability index at two decimals, MISSING when undefined."""
     return number(value, 2)
-
-
-def verdict_word(capable: bool | None) -> str:
-    """The verdict as a word: CAPABLE, NOT CAPABLE, or NO VERDICT (no limits, too few)."""
-    return {True: "CAPABLE", False: "NOT CAPABLE"}.get(capable, "NO VERDICT")  # type: ignore[arg-type]
 
 
 def parse_time(text: str) -> datetime | None:
@@ -292,22 +291,29 @@ def _gauges(header: Mapping[str, Any], events: Sequence[Mapping[str, Any]]) -> t
     return tuple(gauges)
 
 
-def _limits(header: Mapping[str, Any], places: int) -> tuple[LimitLine, ...]:
+def _reading(value: Any, resolution: float | None) -> str:
+    """A reading, zero offset or limit as the gauge shows it (``+0.0012``), ``-`` when absent."""
+    if value is None or isinstance(value, bool) or not isinstance(value, int | float):
+        return MISSING
+    return format_value(float(value), resolution)
+
+
+def _limits(header: Mapping[str, Any], resolution: float | None) -> tuple[LimitLine, ...]:
     lines = []
     for channel, spec in (header.get("limits") or {}).items():
         if isinstance(spec, Mapping):
             lines.append(
                 LimitLine(
                     channel=str(channel),
-                    lsl=number(spec.get("lsl"), places, signed=True),
-                    usl=number(spec.get("usl"), places, signed=True),
-                    nominal=number(spec.get("nominal"), places, signed=True),
+                    lsl=_reading(spec.get("lsl"), resolution),
+                    usl=_reading(spec.get("usl"), resolution),
+                    nominal=_reading(spec.get("nominal"), resolution),
                 )
             )
     return tuple(lines)
 
 
-def _zeroes(session: Any, places: int) -> tuple[ZeroLine, ...]:
+def _zeroes(session: Any, resolution: float | None) -> tuple[ZeroLine, ...]:
     lines = []
     for event in session.zeroes:
         for channel, spec in (event.get("channels") or {}).items():
@@ -324,13 +330,13 @@ def _zeroes(session: Any, places: int) -> tuple[ZeroLine, ...]:
                     ),
                     channel=str(channel),
                     method=str(spec.get("method") or MISSING),
-                    offset=MISSING if offset is None else number(offset, places, signed=True),
+                    offset=_reading(offset, resolution),
                 )
             )
     return tuple(lines)
 
 
-def _readings(session: Any, places: int) -> tuple[ReadingRow, ...]:
+def _readings(session: Any, resolution: float | None) -> tuple[ReadingRow, ...]:
     rows = []
     for cycle_number in sorted(session.cycles):
         cycle = session.cycles[cycle_number]
@@ -341,7 +347,7 @@ def _readings(session: Any, places: int) -> tuple[ReadingRow, ...]:
                 time=short_time(cycle.t),
                 placement=MISSING if cycle.placement is None else str(cycle.placement),
                 values=tuple(
-                    number(cycle.readings[c].value, places, signed=True)
+                    _reading(cycle.readings[c].value, resolution)
                     if c in cycle.readings
                     else MISSING
                     for c in session.channels
@@ -352,12 +358,16 @@ def _readings(session: Any, places: int) -> tuple[ReadingRow, ...]:
     return tuple(rows)
 
 
-def _verdicts(analysed: AnalysedSession, places: int) -> tuple[Verdict, ...]:
+def _verdicts(analysed: AnalysedSession, resolution: float | None) -> tuple[Verdict, ...]:
+    from station.analysis.report import decimals_for as report_decimals
+
     if analysed.report is None or analysed.report.analysis is None:
         return ()
     verdicts = []
     for key, channel in analysed.report.analysis.channels.items():
         cap = channel.capability
+        # The decimals `station analyze` prints this channel's statistics with.
+        places = report_decimals(resolution, channel.descriptive.sd or channel.descriptive.range)
         verdicts.append(
             Verdict(
                 channel=str(key),
@@ -369,19 +379,22 @@ def _verdicts(analysed: AnalysedSession, places: int) -> tuple[Verdict, ...]:
                 cpk=index(cap.cpk),
                 cpk_lower=index(cap.cpk_lower),
                 confidence=f"{cap.confidence:.0%}",
-                word=verdict_word(cap.capable),
+                word=verdict_word(cap),
                 message=str(cap.message or ""),
             )
         )
     return tuple(verdicts)
 
 
-def _figures(analysed: AnalysedSession, places: int) -> tuple[tuple[str, str], ...]:
+def _figures(analysed: AnalysedSession, resolution: float | None) -> tuple[tuple[str, str], ...]:
+    from station.analysis.report import decimals_for as report_decimals
+
     if analysed.report is None or analysed.report.analysis is None:
         return ()
     spatial = analysed.report.analysis.spatial
     if spatial is None:
         return ()
+    places = report_decimals(resolution, spatial.l_sd or spatial.total_offset)
     figures = [
         (f"Offset {axis} (mean − nominal)", number(value, places, signed=True))
         for axis, value in spatial.offset.items()
@@ -395,14 +408,14 @@ def build_content(analysed: AnalysedSession) -> ReportContent:
     """The report's content for an analysed session (see the module)."""
     session = analysed.session
     header = session.header
-    resolution = header.get("resolution")
-    places = decimals_for(resolution if isinstance(resolution, int | float) else None)
+    recorded = header.get("resolution")
+    resolution = float(recorded) if isinstance(recorded, int | float) and recorded > 0 else None
     times = [t for t in (parse_time(e["t"]) for e in session.events) if t is not None]
     duration = duration_text((times[-1] - times[0]).total_seconds()) if times else MISSING
     procedure = header.get("procedure") or {}
     acks = _acknowledgements(session)
     report = analysed.report
-    streamed = MISSING
+    streamed = ""
     if session.samples:
         points = sum(len(batch.values) for batch in session.samples)
         strokes = len({batch.stroke for batch in session.samples})
@@ -437,15 +450,15 @@ def build_content(analysed: AnalysedSession) -> ReportContent:
         duration=duration,
         status=session.status,
         unit=session.unit,
-        resolution=MISSING if not resolution else f"{resolution:g}",
+        resolution=MISSING if resolution is None else f"{resolution:g}",
         rules=str(header.get("rules") or "report"),
         threshold=f"{float(header.get('threshold') or 1.0):g}",
         trigger=str((header.get("instruments") or {}).get("trigger") or MISSING),
         gauges=_gauges(header, session.events),
-        zeroes=_zeroes(session, places),
-        limits=_limits(header, places),
+        zeroes=_zeroes(session, resolution),
+        limits=_limits(header, resolution),
         channels=session.channels,
-        readings=_readings(session, places),
+        readings=_readings(session, resolution),
         rejected=tuple((str(c), str(r)) for c, r in sorted(session.rejected.items())),
         streamed=streamed,
         notes=tuple(
@@ -457,12 +470,12 @@ def build_content(analysed: AnalysedSession) -> ReportContent:
             for note in session.notes
         ),
         alarms=alarms,
-        verdicts=_verdicts(analysed, places),
-        figures=_figures(analysed, places),
+        verdicts=_verdicts(analysed, resolution),
+        figures=_figures(analysed, resolution),
         sections=report.sections if report is not None else (),
         hints=tuple(report.analysis.hints) if report is not None and report.analysis else (),
         anchor=session.last_hash,
         signature=signature_id(session),
-        problem=analysed.problem or MISSING,
-        torn=session.torn.message if session.torn is not None else MISSING,
+        problem=analysed.problem or "",
+        torn=session.torn.message if session.torn is not None else "",
     )

@@ -19,8 +19,9 @@ from pathlib import Path
 from typing import Any
 
 from station.errors import StationError
-from station.record.content import parse_time, verdict_word
+from station.record.content import parse_time
 from station.record.source import analyse_session
+from station.text import UNDEFINED, overall_verdict, verdict_word
 
 SECONDS_PER_DAY = 86400.0
 
@@ -93,7 +94,7 @@ def _entry(path: Path, baseline_session: str | None) -> HistoryEntry:
     session = analysed.session
     channels: dict[str, ChannelFigures] = {}
     rp = None
-    verdict = "NO VERDICT"
+    verdict = UNDEFINED
     if analysed.report is not None and analysed.report.analysis is not None:
         analysis = analysed.report.analysis
         for name, channel in analysis.channels.items():
@@ -109,11 +110,7 @@ def _entry(path: Path, baseline_session: str | None) -> HistoryEntry:
             )
         if analysis.spatial is not None:
             rp = analysis.spatial.rp
-        verdicts = [c.capable for c in channels.values()]
-        if any(v is False for v in verdicts):
-            verdict = verdict_word(False)
-        elif verdicts and all(v is True for v in verdicts):
-            verdict = verdict_word(True)
+        verdict = overall_verdict(verdict_word(c.capability) for c in analysis.channels.values())
     return HistoryEntry(
         path=path,
         created=session.created,

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from station.cli import main
-from station.record.content import acknowledgement_of, build_content
+from station.record.content import MISSING, acknowledgement_of, build_content
 from station.record.render import render_report
 from station.record.source import analyse_session
 
@@ -238,7 +238,7 @@ def test_acknowledgements_are_matched_to_their_alarm():
     other = {**by_rule, "rule": "report-4"}
     assert acknowledgement_of(alarm, [by_seq]) == "fixture moved (ana, 2026-11-23 12:00:05Z)"
     assert acknowledgement_of(alarm, [other, by_rule]).startswith("gauge; reseated")
-    assert acknowledgement_of(alarm, [other]) == "—"
+    assert acknowledgement_of(alarm, [other]) == MISSING
 
 
 def test_report_of_a_real_headless_capture(tmp_path):
