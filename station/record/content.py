@@ -421,7 +421,7 @@ def build_content(analysed: AnalysedSession) -> ReportContent:
         strokes = len({batch.stroke for batch in session.samples})
         streamed = (
             f"{points} streamed points in {strokes} recorded strokes (every point is in the "
-            "session file; `station export --csv` writes them as stroke,s,h,v)"
+            "session file; station export --csv writes them as stroke,s,h,v)"
         )
     alarms = tuple(
         AlarmLine(
