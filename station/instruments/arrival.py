@@ -138,6 +138,8 @@ class ArrivalDetector(Generic[Item]):
         self.t_arrived: float | None = None
         """The first arrival after the current departure (None while none)."""
         self.now = float("-inf")
+        self._t_in_band = float("-inf")
+        """When every channel last came (back) into its band."""
 
     def reset(self) -> None:
         """Forget the motion seen so far: only a departure after this counts (arm)."""
@@ -172,6 +174,7 @@ class ArrivalDetector(Generic[Item]):
             if outside or any(s.latest is None for s in self._channels.values()):
                 return events
             self.state = "returned"
+            self._t_in_band = t
             if self.t_arrived is None:
                 self.t_arrived = t
             for each in self._channels.values():
@@ -182,6 +185,18 @@ class ArrivalDetector(Generic[Item]):
         # returned
         if outside:
             self.state = "away"
+            arrived = self.t_arrived
+            if arrived is not None and t - self._t_in_band >= self.config.settle:
+                # Back (in the band throughout) for a settle time, never still, and gone
+                # again: that return is lost (reported), and this is a departure of its own.
+                # A shorter stay is a bounce of the approach and keeps the first arrival.
+                moving = self._unsettled_in_windows() or outside
+                message = unsettled_message(moving, self.config, t - arrived, left=True)
+                events.append(
+                    ArrivalEvent("unsettled", t, moving, t_arrived=arrived, message=message)
+                )
+                events.append(ArrivalEvent("departed", t, outside))
+                self.t_arrived = None
             return events
         state.window.append((t, value, item))
         self._trim(state, t)
@@ -215,6 +230,19 @@ class ArrivalDetector(Generic[Item]):
         for state in self._channels.values():
             state.window.clear()
         return [event]
+
+    def _unsettled_in_windows(self) -> tuple[str, ...]:
+        """Channels whose kept readings were not still for a settle time."""
+        moving = []
+        for channel, state in self._channels.items():
+            since = self._still_since(state)
+            if (
+                since is None
+                or not state.window
+                or state.window[-1][0] - since < self.config.settle
+            ):
+                moving.append(channel)
+        return tuple(moving)
 
     def moving_channels(self) -> tuple[str, ...]:
         """Channels not still for a settle time (or out of their band) at the detector's time."""
@@ -275,15 +303,19 @@ class ArrivalDetector(Generic[Item]):
         return max(values) - min(values) if values else 0.0
 
 
-def unsettled_message(moving: Sequence[str], config: ArrivalConfig, waited: float) -> str:
-    """The sentence for a return that did not settle (no full stop inside, one at the end)."""
+def unsettled_message(
+    moving: Sequence[str], config: ArrivalConfig, waited: float, *, left: bool = False
+) -> str:
+    """The sentence for a return that did not settle: ``left`` when the robot went away again
+    before it was still, else it was not still within the timeout."""
     who = ", ".join(moving) if moving else "the gauges"
     verb = "was" if len(moving) == 1 else "were"
+    when = f"before it left again ({waited:.1f} s)" if left else f"after {waited:.1f} s"
     return (
         f"The robot came back to the fixture but {who} {verb} not still within "
-        f"{config.still:g} resolutions for {config.settle:g} s after {waited:.1f} s; "
-        "no set was taken for this return. Let it come to rest (check the robot and the "
-        "fixture), then run the cycle again."
+        f"{config.still:g} resolutions for {config.settle:g} s {when}; "
+        "no set was taken for this return. Let the robot come to rest at the fixture (check "
+        "the robot and the fixture), then run the cycle again."
     )
 
 
