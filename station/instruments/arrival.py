@@ -9,8 +9,8 @@ pure (no threads, no clock: the time is each reading's own ``t``), fed one readi
 * **away**: waiting for every channel to be back inside its band (an **arrival**; the moment of
   the first arrival after a departure is kept).
 * **returned**: every channel back; waiting for **stillness**: each channel's readings of the
-  last ``settle`` seconds lie within ``still`` resolutions of each other (and none of them is
-  more than half a settle time older than the next: a gap is no proof of stillness). Then the
+  last ``settle`` seconds lie within ``still`` resolutions of each other (and no two of them
+  are a whole settle time apart: a silent line is no proof of stillness). Then the
   latest reading of every channel is one set, and the detector waits for the next departure.
   A channel leaving its band again goes back to *away*, keeping the first arrival's moment.
 * A robot that came back but is not still ``timeout`` seconds after its first arrival is
@@ -264,7 +264,9 @@ class ArrivalDetector(Generic[Item]):
     # -- stillness -----------------------------------------------------------------------
 
     def _max_gap(self) -> float:
-        return self.config.settle / 2.0
+        """The longest pause between two readings of a channel that still counts as watching
+        it: a port silent for a whole settle time proves nothing about stillness."""
+        return self.config.settle
 
     def _trim(self, state: _Channel[Item], t: float) -> None:
         """Keep the readings of the last settle time, and one before it (the window's start)."""

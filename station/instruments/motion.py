@@ -16,8 +16,8 @@ bias, noise, drift and backlash for that cycle). One period is, in order:
 So cycle ``c``'s rest position is shown from ``c × period`` to ``c × period + dwell``; the
 robot arrives at cycle ``c + 1``'s position at the end of cycle ``c``'s period. A *hunting* axis
 (``hunt``: a servo that does not settle) swings about its rest position by ± the amplitude
-while at rest on every ``hunt_every``-th return, so the station must report that return rather
-than record it.
+from its return (settling included) to its departure on every ``hunt_every``-th return, so
+the station must report that return rather than record it.
 """
 
 from __future__ import annotations
@@ -118,10 +118,7 @@ class CycleMotion:
         smooth = (1.0 - math.cos(math.pi * u)) / 2.0
         free = self.free(channel)
         if stage == "at rest":
-            if self.hunts(channel, cycle):
-                swing = 2.0 * math.pi * (t / self.hunt_period)
-                return rest + self.hunt[channel] * math.sin(swing)
-            return rest
+            return rest + self._hunting(channel, cycle, t)
         if stage == "departing":
             return rest + (free - rest) * smooth
         if stage == "away":
@@ -129,9 +126,16 @@ class CycleMotion:
         target = next_rest + math.copysign(self.overshoot, next_rest - free)
         if stage == "approaching":
             return free + (target - free) * smooth
-        # A damped swing from the overshoot, ending exactly on the rest position.
+        # A damped swing from the overshoot, ending exactly on the rest position (a hunting
+        # axis never gets there: it hunts from the moment it is back).
         swing = math.exp(-5.0 * u) * math.cos(3.0 * math.pi * u) * (1.0 - u)
-        return next_rest + (target - next_rest) * swing
+        return next_rest + (target - next_rest) * swing + self._hunting(channel, cycle + 1, t)
+
+    def _hunting(self, channel: str, cycle: int, t: float) -> float:
+        """The hunting swing of ``channel`` at ``t`` (0 unless it hunts in ``cycle``)."""
+        if not self.hunts(channel, cycle):
+            return 0.0
+        return self.hunt[channel] * math.sin(2.0 * math.pi * t / self.hunt_period)
 
 
 def default_free_travel(unit: str) -> float:
