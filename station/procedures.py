@@ -22,6 +22,14 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
     min = 25
     target = 30
 
+    [arrival]                       # optional: the arrival trigger (cycles paced by the robot)
+    band = 0.01                     # a channel farther than this from its zero has left the
+                                    # fixture (in `unit`; default 100 x the gauge resolution)
+    still = 2                       # resolutions the readings may spread and still be still (2)
+    settle = 0.5                    # seconds of stillness before the set is taken (0.5)
+    timeout = 10.0                  # seconds after its return by which the robot must be
+                                    # still, else the return is reported, not recorded (10)
+
     [limits]                        # optional; either a tolerance about a nominal for every channel
     tolerance = 0.001
     nominal = 0.0                   # optional, default 0
@@ -36,7 +44,10 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
 Keys per step kind, beyond ``id``, ``kind``, ``title`` and ``text``:
 
 - ``input``: ``fields = [{ name, label, type = "number"|"text", unit, required }]``
-- ``zero``, ``capture``: ``channels`` (default: all the procedure's channels)
+- ``zero``: ``channels`` (default: all), ``readings`` (per channel, 2 or more; default 10),
+  ``settle`` (seconds the readings are spread over; default 1.0) and ``still`` (resolutions
+  the readings may spread before a gauge counts as moving and the zero is refused; default 3)
+- ``capture``: ``channels`` (default: all the procedure's channels)
 - ``cycles``: ``channels``, ``min``, ``target`` (default: the procedure's cycle counts), ``prompt``
   (shown before each cycle; ``{cycle}`` and ``{count}`` are replaced by plain text substitution)
 - ``stroke``: ``channels``, ``direction_channel`` (the channel that tracks the position along the
@@ -58,6 +69,12 @@ from pathlib import Path
 from typing import Any, Literal
 
 from station.errors import StationError
+from station.instruments.arrival import ArrivalConfig
+from station.instruments.zeroing import (
+    DEFAULT_ZERO_READINGS,
+    DEFAULT_ZERO_SETTLE,
+    DEFAULT_ZERO_STILL,
+)
 
 StepKind = Literal["check", "input", "zero", "capture", "cycles", "stroke", "repeat"]
 STEP_KINDS: tuple[str, ...] = ("check", "input", "zero", "capture", "cycles", "stroke", "repeat")
@@ -107,6 +124,12 @@ class Step:
     steps: tuple[Step, ...] = ()
     number: str = ""
     """Where the step is in the file, 1-based: ``"3"``, or ``"5.2"`` inside a repeat block."""
+    readings: int | None = None
+    """A ``zero`` step: readings per channel the zero is the mean of (None for other kinds)."""
+    settle: float | None = None
+    """A ``zero`` step: seconds its readings are spread over."""
+    still: float | None = None
+    """A ``zero`` step: resolutions its readings may spread before the zero is refused."""
 
     def prompt_for(self, cycle: int, count: int) -> str:
         """The per-cycle prompt with ``{cycle}`` and ``{count}`` filled in (plain substitution)."""
@@ -143,6 +166,8 @@ class Procedure:
     sha256: str
     analysis: AnalysisKind = "repeatability"
     """How its sessions are analysed: the file's ``analysis``, else by its steps."""
+    arrival: ArrivalConfig = field(default_factory=ArrivalConfig)
+    """The ``arrival`` trigger's parameters: the file's ``[arrival]``, else the defaults."""
 
     def all_steps(self) -> Iterator[Step]:
         """Every step in file order, including those inside repeat blocks (after their block)."""
@@ -310,12 +335,13 @@ _TOP_KEYS = (
     "cycles",
     "limits",
     "steps",
+    "arrival",
 )
 _COMMON_STEP_KEYS = ("id", "kind", "title", "text")
 _STEP_KEYS: dict[str, tuple[str, ...]] = {
     "check": (),
     "input": ("fields",),
-    "zero": ("channels",),
+    "zero": ("channels", "readings", "settle", "still"),
     "capture": ("channels",),
     "cycles": ("channels", "min", "target", "prompt"),
     "stroke": ("channels", "direction_channel", "min", "target", "prompt"),
@@ -373,6 +399,7 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
         raise check.fail("[cycles]", f"min {cycles_min} is more than target {cycles_target}")
 
     limits = _parse_limits(check, check.get(table, "limits", dict, "", required=False), channels)
+    arrival = _parse_arrival(check, check.get(table, "arrival", dict, "", required=False))
 
     raw_steps = check.get(table, "steps", list, "")
     if not raw_steps:
@@ -398,7 +425,24 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
         path=path,
         sha256=hashlib.sha256(data).hexdigest(),
         analysis=analysis,
+        arrival=arrival,
     )
+
+
+def _parse_arrival(check: _Checker, table: Mapping[str, Any] | None) -> ArrivalConfig:
+    """The ``[arrival]`` table: band, still, settle, timeout (each optional)."""
+    if not table:
+        return ArrivalConfig()
+    where = "[arrival]"
+    check.only_keys(table, ("band", "still", "settle", "timeout"), where)
+    given = {key: check.number(table, key, where) for key in table}
+    for key, value in given.items():
+        if not value > 0:
+            raise check.fail(where, f"{key!r} must be greater than 0, not {value}")
+    try:
+        return ArrivalConfig(**given)
+    except StationError as error:
+        raise check.fail(where, error.message.rstrip(".")) from None
 
 
 def _analysis_kind(
@@ -527,6 +571,18 @@ def _parse_step(context: _StepContext, raw: Any, number: str, *, nested: bool = 
         values["count_min"], values["count_target"] = count_min, count_target
     if kind == "input":
         values["fields"] = _parse_fields(check, raw, where)
+    if kind == "zero":
+        readings = check.get(raw, "readings", int, where, required=False)
+        if readings is not None and readings < 2:
+            raise check.fail(
+                where, f"'readings' must be 2 or more (a zero is a mean), not {readings}"
+            )
+        values["readings"] = readings or DEFAULT_ZERO_READINGS
+        for key, default in (("settle", DEFAULT_ZERO_SETTLE), ("still", DEFAULT_ZERO_STILL)):
+            number = check.number(raw, key, where, required=False)
+            if number is not None and not number > 0:
+                raise check.fail(where, f"{key!r} must be greater than 0, not {number}")
+            values[key] = default if number is None else number
     if kind == "stroke":
         direction = check.text(raw, "direction_channel", where)
         if direction not in values["channels"]:

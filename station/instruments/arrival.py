@@ -12,7 +12,9 @@ pure (no threads, no clock: the time is each reading's own ``t``), fed one readi
   last ``settle`` seconds lie within ``still`` resolutions of each other (and no two of them
   are a whole settle time apart: a silent line is no proof of stillness). Then the
   latest reading of every channel is one set, and the detector waits for the next departure.
-  A channel leaving its band again goes back to *away*, keeping the first arrival's moment.
+  A channel leaving its band again after less than a quarter of the settle time is a bounce
+  (back to *away*, keeping the first arrival's moment); after longer, the robot came back
+  without settling and left: that return is reported (``unsettled``) and this is a departure.
 * A robot that came back but is not still ``timeout`` seconds after its first arrival is
   **reported** (an ``unsettled`` event with a sentence naming the channels that still move) and
   nothing is taken for that return: the next departure starts afresh.
@@ -186,10 +188,11 @@ class ArrivalDetector(Generic[Item]):
         if outside:
             self.state = "away"
             arrived = self.t_arrived
-            if arrived is not None and t - self._t_in_band >= self.config.settle:
-                # Back (in the band throughout) for a settle time, never still, and gone
-                # again: that return is lost (reported), and this is a departure of its own.
-                # A shorter stay is a bounce of the approach and keeps the first arrival.
+            if arrived is not None and t - self._t_in_band >= self.config.settle / 4:
+                # Back (in the band throughout) for a while, never still, and gone again:
+                # that return is lost (reported), and this is a departure of its own. A stay
+                # shorter than a quarter of the settle time is a bounce of the approach (an
+                # overshoot past the band) and keeps the first arrival.
                 moving = self._unsettled_in_windows() or outside
                 message = unsettled_message(moving, self.config, t - arrived, left=True)
                 events.append(
