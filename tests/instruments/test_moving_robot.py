@@ -232,3 +232,40 @@ def _wait_until(simulator: Simulator, t: float) -> None:
     remaining = simulator.motion_t0 + t - time.monotonic()
     if remaining > 0:
         threading.Event().wait(remaining)
+
+
+def test_a_pushing_gauge_paces_the_arrival_trigger_and_states_its_unit() -> None:
+    """U-WAVE pushes by itself (no polls) and its frames say inches: the arrival trigger works
+    on the stream alone, and the frames refuse a session in mm."""
+    model = FixtureModel(
+        dict.fromkeys("xy", AxisModel(noise=0.001)), GaugeSpec(0.0001, -0.5, 0.5, "in")
+    )
+    motion = CycleMotion(PERIOD, -0.375, 0.002)
+    simulator = Simulator(get_protocol("uwave"), model, seed=SEED, push_rate=50, motion=motion)
+    url = simulator.start_tcp(0)
+    gauges = GaugeSet(
+        [PortSpec(url, get_protocol("uwave"), {"1": "x", "2": "y"})],
+        trigger="arrival",
+        unit="in",
+        resolution=0.0001,
+        arrival=ArrivalConfig(settle=0.06, timeout=1.0),
+        backoff=(0.05, 0.2),
+    )
+    try:
+        gauges.start()
+        assert gauges.wait_connected(5.0) and simulator.wait_client(5.0)
+        sets = [gauges.wait_set(3 * PERIOD) for _ in range(2)]
+        refused = gauges.check_frames("mm", 0.0001, readings=3)
+    finally:
+        gauges.stop()
+        simulator.stop()
+    assert all(s is not None and s.complete for s in sets)
+    for result in sets:
+        for channel, reading in result.readings.items():
+            assert reading.frame_unit == "in"
+            cycle = simulator.motion.stage(reading.t_mono - simulator.motion_t0)[0]
+            # Taken at rest (or in the last, still, part of the settling swing before it,
+            # which may round one count off).
+            rests = (simulator.rest_value(channel, cycle), simulator.rest_value(channel, cycle + 1))
+            assert min(abs(reading.value - rest) for rest in rests) <= 0.00011, reading
+    assert refused == "the gauges send steps of 0.0001 in; the session is in mm at 0.0001"
