@@ -1047,6 +1047,17 @@ class GaugeSet:
         if readings == 1:
             return self._zero_once(wanted, commands, timeout, unit)
         taken = self.collect(wanted, readings, settle, timeout)
+        down = [
+            c
+            for c in wanted
+            if len(taken[c]) < readings and self._reader_of[c].state != "connected"
+        ]
+        if down:
+            reader = self._reader_of[down[0]]
+            raise StationError(
+                f"Could not zero {', '.join(down)}: {reader._down_message()}. Check the cable "
+                "and try again."
+            )
         if unit is not None:
             latest = {c: values[-1] for c, values in taken.items() if values}
             mismatch = unit_mismatch(latest, wanted, unit)

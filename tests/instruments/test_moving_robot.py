@@ -269,3 +269,16 @@ def test_a_pushing_gauge_paces_the_arrival_trigger_and_states_its_unit() -> None
             rests = (simulator.rest_value(channel, cycle), simulator.rest_value(channel, cycle + 1))
             assert min(abs(reading.value - rest) for rest in rests) <= 0.00011, reading
     assert refused == "the gauges send steps of 0.0001 in; the session is in mm at 0.0001"
+
+
+def test_a_zero_on_a_port_that_is_down_says_so(tmp_path) -> None:
+    gauges = GaugeSet(
+        [PortSpec(str(tmp_path / "no-such-port"), get_protocol("mitutoyo"), MAP)],
+        backoff=(0.05, 0.2),
+    )
+    try:
+        gauges.start()
+        with pytest.raises(StationError, match=r"Could not zero x, y, z: the port .* (is|not)"):
+            gauges.zero(readings=3, settle=0.05, timeout=0.2)
+    finally:
+        gauges.stop()
