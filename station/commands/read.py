@@ -261,8 +261,9 @@ def _print_arrival(event) -> None:
 class FrameWatch:
     """What the frames read so far say (decimals, steps, unit), printed when it changes."""
 
-    def __init__(self, protocol, keep: int = 256) -> None:
+    def __init__(self, protocol, channels=(), keep: int = 256) -> None:
         self.protocol = protocol
+        self.channels = tuple(channels)
         self.keep = keep
         self.samples: dict[str, list] = {}
         self.said = ""
@@ -280,6 +281,8 @@ class FrameWatch:
         kept = self.samples.setdefault(reading.channel, [])
         kept.append(sample)
         del kept[: -self.keep]
+        if any(channel not in self.samples for channel in self.channels):
+            return ""  # one line for the whole set, once every channel has spoken
         text = describe_inference(
             {
                 channel: infer_channel(channel, values, self.protocol.units_by_decimals)
@@ -295,7 +298,7 @@ class FrameWatch:
 def _loop(reader, gauges, events, trigger, count, interval, jsonl, resolution) -> int:
     from station.instruments.base import Reading
 
-    watch = FrameWatch(reader.protocol)
+    watch = FrameWatch(reader.protocol, reader.channels)
 
     def note(item) -> None:
         if isinstance(item, Reading):

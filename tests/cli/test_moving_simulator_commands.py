@@ -50,6 +50,7 @@ def test_read_prints_one_set_per_round_trip_and_what_the_frames_say() -> None:
     assert found[1] == found[0] + 1
     assert "station: the robot left the fixture" in result.stderr
     assert "station: x, y, z send steps of 0.001, which is mm on this protocol" in result.stderr
+    assert "station: x sends" not in result.stderr  # one line once every channel has spoken
 
 
 @pytest.mark.parametrize(
