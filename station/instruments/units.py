@@ -50,10 +50,10 @@ class FrameSample:
 class FrameInference:
     """What a channel's frames say about its gauge.
 
-    ``decimals``: digits after the point (the most seen; None when no frame shows a point and
-    the values say nothing). ``step``: the step the values move by (10^-decimals, or a multiple
-    of it once ``MIN_DISTINCT_FOR_STEP`` distinct values show one). ``unit``: stated by the
-    frames; ``protocol_unit``: implied by the decimals on this protocol; either may be None.
+    ``decimals``: digits after the point (the most any frame wrote). ``step``: the step the
+    values move by (10^-decimals, or a multiple of it once ``MIN_DISTINCT_FOR_STEP`` distinct
+    values show one). ``unit``: stated by the frames; ``protocol_unit``: implied by the
+    decimals on this protocol; either may be None.
     """
 
     channel: str
@@ -105,10 +105,9 @@ def infer_channel(
     if not samples:
         return FrameInference(channel, 0, None, None)
     counted = [s.decimals for s in samples if s.decimals is not None]
-    if counted:
-        decimals = max(set(counted), key=lambda d: (counted.count(d), d))
-    else:
-        decimals = max(decimals_of_value(s.value) for s in samples)
+    # The most written: an adaptor that prints floats drops trailing zeros (0.1 for 0.100).
+    values_decimals = (decimals_of_value(s.value) for s in samples)
+    decimals = max(counted) if counted else max(values_decimals)
     unit_counts: dict[str, int] = {}
     for sample in samples:
         if sample.unit:

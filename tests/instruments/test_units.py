@@ -103,3 +103,14 @@ def test_no_frames_say_nothing() -> None:
     inferred = {"x": infer_channel("x", [], MITUTOYO.units_by_decimals)}
     assert frames_disagree(inferred, "in", 0.0001) == ""
     assert describe_inference(inferred) == "x: nothing yet"
+
+
+def test_an_adaptor_that_drops_trailing_zeros_still_shows_its_decimals() -> None:
+    ascii_lines = get_protocol("ascii")
+    frames = [b"0.1", b"0.123", b"-0.02", b"0.101"]
+    samples = [
+        FrameSample(ascii_lines.parse(f).value, ascii_lines.frame_decimals(f)) for f in frames
+    ]
+    inferred = infer_channel("x", samples, ascii_lines.units_by_decimals)
+    assert (inferred.decimals, inferred.step, inferred.protocol_unit) == (3, 0.001, None)
+    assert inferred.describe() == "steps of 0.001 (the frames carry no unit)"
