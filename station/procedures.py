@@ -22,6 +22,14 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
     min = 25
     target = 30
 
+    [arrival]                       # optional: the arrival trigger (cycles paced by the robot)
+    band = 0.01                     # a channel farther than this from its zero has left the
+                                    # fixture (in `unit`; default 100 x the gauge resolution)
+    still = 2                       # resolutions the readings may spread and still be still (2)
+    settle = 0.5                    # seconds of stillness before the set is taken (0.5)
+    timeout = 10.0                  # seconds after its return by which the robot must be
+                                    # still, else the return is reported, not recorded (10)
+
     [limits]                        # optional; either a tolerance about a nominal for every channel
     tolerance = 0.001
     nominal = 0.0                   # optional, default 0
@@ -36,7 +44,10 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
 Keys per step kind, beyond ``id``, ``kind``, ``title`` and ``text``:
 
 - ``input``: ``fields = [{ name, label, type = "number"|"text", unit, required }]``
-- ``zero``, ``capture``: ``channels`` (default: all the procedure's channels)
+- ``zero``: ``channels`` (default: all), ``readings`` (per channel, 2 or more; default 10),
+  ``settle`` (seconds the readings are spread over; default 1.0) and ``still`` (resolutions
+  the readings may spread before a gauge counts as moving and the zero is refused; default 3)
+- ``capture``: ``channels`` (default: all the procedure's channels)
 - ``cycles``: ``channels``, ``min``, ``target`` (default: the procedure's cycle counts), ``prompt``
   (shown before each cycle; ``{cycle}`` and ``{count}`` are replaced by plain text substitution)
 - ``stroke``: ``channels``, ``direction_channel`` (the channel that tracks the position along the
@@ -58,6 +69,12 @@ from pathlib import Path
 from typing import Any, Literal
 
 from station.errors import StationError
+from station.instruments.arrival import ArrivalConfig
+from station.instruments.zeroing import (
+    DEFAULT_ZERO_READINGS,
+    DEFAULT_ZERO_SETTLE,
+    DEFAULT_ZERO_STILL,
+)
 
 StepKind = str
 """A step kind: one of :func:`step_kinds` (the built-ins, and any a handler registered)."""
@@ -83,6 +100,8 @@ class StepSchema:
     """``direction_channel``: the channel tracking the position along a stream."""
     block: bool = False
     """A block of inner ``steps`` repeated ``target`` times (no nesting)."""
+    zero_window: bool = False
+    """``readings``, ``settle`` and ``still``: a zero taken as the mean of several readings."""
     implies_analysis: str | None = None
     """The analysis kind a procedure holding this step defaults to."""
 
@@ -95,6 +114,7 @@ class StepSchema:
             + (("fields",) if self.fields else ())
             + (("direction_channel",) if self.direction else ())
             + (("label", "min", "target", "prompt", "steps") if self.block else ())
+            + (("readings", "settle", "still") if self.zero_window else ())
         )
         return tuple(dict.fromkeys(shared + self.keys))
 
@@ -102,7 +122,7 @@ class StepSchema:
 _STEP_SCHEMAS: dict[str, StepSchema] = {
     "check": StepSchema(),
     "input": StepSchema(fields=True),
-    "zero": StepSchema(channels=True),
+    "zero": StepSchema(channels=True, zero_window=True),
     "capture": StepSchema(channels=True),
     "cycles": StepSchema(channels=True, counts=True),
     "stroke": StepSchema(channels=True, counts=True, direction=True, implies_analysis="linearity"),
@@ -196,6 +216,12 @@ class Step:
     """Where the step is in the file, 1-based: ``"3"``, or ``"5.2"`` inside a repeat block."""
     options: Mapping[str, Any] = field(default_factory=dict)
     """The values of the keys a registered step kind declares as its own (``schema.keys``)."""
+    readings: int | None = None
+    """A ``zero`` step: readings per channel the zero is the mean of (None for other kinds)."""
+    settle: float | None = None
+    """A ``zero`` step: seconds its readings are spread over."""
+    still: float | None = None
+    """A ``zero`` step: resolutions its readings may spread before the zero is refused."""
 
     def prompt_for(self, cycle: int, count: int) -> str:
         """The per-cycle prompt with ``{cycle}`` and ``{count}`` filled in (plain substitution)."""
@@ -232,6 +258,8 @@ class Procedure:
     sha256: str
     analysis: AnalysisKind = "repeatability"
     """How its sessions are analysed: the file's ``analysis``, else by its steps."""
+    arrival: ArrivalConfig = field(default_factory=ArrivalConfig)
+    """The ``arrival`` trigger's parameters: the file's ``[arrival]``, else the defaults."""
 
     def all_steps(self) -> Iterator[Step]:
         """Every step in file order, including those inside repeat blocks (after their block)."""
@@ -399,6 +427,7 @@ _TOP_KEYS = (
     "cycles",
     "limits",
     "steps",
+    "arrival",
 )
 _COMMON_STEP_KEYS = ("id", "kind", "title", "text")
 _FIELD_KEYS = ("name", "label", "type", "unit", "required")
@@ -453,6 +482,7 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
         raise check.fail("[cycles]", f"min {cycles_min} is more than target {cycles_target}")
 
     limits = _parse_limits(check, check.get(table, "limits", dict, "", required=False), channels)
+    arrival = _parse_arrival(check, check.get(table, "arrival", dict, "", required=False))
 
     raw_steps = check.get(table, "steps", list, "")
     if not raw_steps:
@@ -478,7 +508,24 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
         path=path,
         sha256=hashlib.sha256(data).hexdigest(),
         analysis=analysis,
+        arrival=arrival,
     )
+
+
+def _parse_arrival(check: _Checker, table: Mapping[str, Any] | None) -> ArrivalConfig:
+    """The ``[arrival]`` table: band, still, settle, timeout (each optional)."""
+    if not table:
+        return ArrivalConfig()
+    where = "[arrival]"
+    check.only_keys(table, ("band", "still", "settle", "timeout"), where)
+    given = {key: check.number(table, key, where) for key in table}
+    for key, value in given.items():
+        if not value > 0:
+            raise check.fail(where, f"{key!r} must be greater than 0, not {value}")
+    try:
+        return ArrivalConfig(**given)
+    except StationError as error:
+        raise check.fail(where, error.message.rstrip(".")) from None
 
 
 def _analysis_kind(
@@ -613,6 +660,18 @@ def _parse_step(context: _StepContext, raw: Any, number: str, *, nested: bool = 
         values["count_min"], values["count_target"] = count_min, count_target
     if schema.fields:
         values["fields"] = _parse_fields(check, raw, where)
+    if schema.zero_window:
+        readings = check.get(raw, "readings", int, where, required=False)
+        if readings is not None and readings < 2:
+            raise check.fail(
+                where, f"'readings' must be 2 or more (a zero is a mean), not {readings}"
+            )
+        values["readings"] = readings or DEFAULT_ZERO_READINGS
+        for key, default in (("settle", DEFAULT_ZERO_SETTLE), ("still", DEFAULT_ZERO_STILL)):
+            number = check.number(raw, key, where, required=False)
+            if number is not None and not number > 0:
+                raise check.fail(where, f"{key!r} must be greater than 0, not {number}")
+            values[key] = default if number is None else number
     if schema.direction:
         direction = check.text(raw, "direction_channel", where)
         if direction not in values["channels"]:

@@ -18,8 +18,17 @@ unit and the raw frame) and one line per rejected frame (error, status,
 malformed, out of range). A polled protocol is polled continuously
 (--interval); a push protocol waits for the device (DATA button, foot switch,
 data logger); --trigger stable prints a set once every channel has stayed
-within 2 x resolution for 0.5 s. Connection changes go to stderr; the reader
-reconnects by itself after an unplug. Ctrl-C stops.
+within 2 x resolution for 0.5 s; --trigger arrival reads continuously and
+prints a set each time the robot has left the fixture (a channel beyond 100
+resolutions from zero) and come back to rest (2 resolutions for --settle
+seconds, default 0.5), with
+"left", "back" and "did not settle" lines on stderr. Connection changes go to
+stderr; the reader reconnects by itself after an unplug. Ctrl-C stops.
+
+What the frames say is printed on stderr as soon as it is known, and again when
+it changes: "station: x, y, z send steps of 0.001, which is mm on this
+protocol" (the decimals in the frames, the step between values, and the unit
+where the frames state it or the protocol's gauges usually show it).
 
 --jsonl prints one JSON object per line instead: {"channel", "value", "unit",
 "raw"} for a reading, {"rejected", "raw"} for a rejected frame (rejected = the
@@ -65,8 +74,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--trigger",
-        choices=("poll", "push", "stable"),
-        help="poll (default for a polled protocol), push (default otherwise) or stable",
+        choices=("poll", "push", "stable", "arrival"),
+        help="poll (default for a polled protocol), push (default otherwise), stable or arrival",
     )
     parser.add_argument("--count", metavar="N", help="stop after N readings")
     parser.add_argument("--jsonl", action="store_true", help="one JSON object per line")
@@ -87,6 +96,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         metavar="R",
         help="gauge resolution: the decimals shown, and the band of --trigger stable "
         "(default 0.001)",
+    )
+    parser.add_argument(
+        "--settle",
+        default="0.5",
+        metavar="S",
+        help="--trigger arrival: seconds the gauges must be still before a set (default 0.5)",
     )
     parser.set_defaults(func=run)
 
@@ -146,12 +161,14 @@ def _print_item(item: object, jsonl: bool, resolution: float) -> bool:
 
 def run(args: argparse.Namespace) -> int:
     """Read until --count readings arrived or Ctrl-C."""
+    from station.instruments.arrival import DEFAULT_TIMEOUT, ArrivalConfig
     from station.instruments.gauge import GaugeReader, GaugeSet, PortSpec
     from station.instruments.protocols import get_protocol
 
     count = positive_number(args.count, "--count", int)
     interval = positive_number(args.interval, "--interval")
     resolution = positive_number(args.resolution, "--resolution")
+    settle = positive_number(args.settle, "--settle")
     channel_map = parse_map(args.map)
     protocol = get_protocol(
         args.protocol,
@@ -180,22 +197,27 @@ def run(args: argparse.Namespace) -> int:
             print(f"station: {status.state}: {status.message}", file=sys.stderr, flush=True)
 
     gauges = None
-    if trigger == "stable":
+    if trigger in ("stable", "arrival"):
         gauges = GaugeSet(
             [PortSpec(args.port, protocol, channel_map)],
-            trigger="stable",
+            trigger=trigger,
             unit=args.unit,
             resolution=resolution,
             poll_interval=interval,
             on_rejection=events.put_nowait,
             on_status=on_status,
+            on_arrival=_print_arrival,
+            arrival=ArrivalConfig(settle=settle, timeout=max(DEFAULT_TIMEOUT, 4 * settle)),
         )
         reader = gauges.readers[0]
     else:
         reader = GaugeReader(
             args.port, protocol, channel_map, unit=args.unit, events=events, on_status=on_status
         )
-    reader.start()
+    if gauges is not None:
+        gauges.start()
+    else:
+        reader.start()
     try:
         _wait_first_open(reader)
         if not args.jsonl:
@@ -225,7 +247,65 @@ def _wait_first_open(reader) -> None:
         raise StationError(message)
 
 
+def _print_arrival(event) -> None:
+    """The arrival trigger's news, on stderr (the sets themselves go to stdout)."""
+    if event.kind == "departed":
+        line = f"the robot left the fixture ({', '.join(event.channels)} out of the band)"
+    elif event.kind == "returned":
+        line = "the robot is back at the fixture; waiting for it to be still"
+    else:
+        line = f"warning: {event.message}"
+    print(f"station: {line}", file=sys.stderr, flush=True)
+
+
+class FrameWatch:
+    """What the frames read so far say (decimals, steps, unit), printed when it changes."""
+
+    def __init__(self, protocol, channels=(), keep: int = 256) -> None:
+        self.protocol = protocol
+        self.channels = tuple(channels)
+        self.keep = keep
+        self.samples: dict[str, list] = {}
+        self.said = ""
+
+    def add(self, reading) -> str:
+        """Note ``reading``'s frame; the new line to print, or '' when nothing changed."""
+        from station.instruments.units import FrameSample, describe_inference, infer_channel
+
+        frame = reading.raw.encode("ascii", "backslashreplace")
+        sample = FrameSample(
+            getattr(reading, "device_value", reading.value),
+            self.protocol.frame_decimals(frame),
+            getattr(reading, "frame_unit", None),
+        )
+        kept = self.samples.setdefault(reading.channel, [])
+        kept.append(sample)
+        del kept[: -self.keep]
+        if any(channel not in self.samples for channel in self.channels):
+            return ""  # one line for the whole set, once every channel has spoken
+        text = describe_inference(
+            {
+                channel: infer_channel(channel, values, self.protocol.units_by_decimals)
+                for channel, values in sorted(self.samples.items())
+            }
+        )
+        if text == self.said:
+            return ""
+        self.said = text
+        return text
+
+
 def _loop(reader, gauges, events, trigger, count, interval, jsonl, resolution) -> int:
+    from station.instruments.base import Reading
+
+    watch = FrameWatch(reader.protocol, reader.channels)
+
+    def note(item) -> None:
+        if isinstance(item, Reading):
+            line = watch.add(item)
+            if line:
+                print(f"station: {line}", file=sys.stderr, flush=True)
+
     readings = 0
     # A poll waits for its answers (or POLL_PATIENCE) before the next one: a new poll flushes
     # the input, so polling faster than the device answers would starve the reader.
@@ -234,11 +314,17 @@ def _loop(reader, gauges, events, trigger, count, interval, jsonl, resolution) -
     polled_at = -1e9
     while count is None or readings < count:
         if gauges is not None:
-            result = gauges.capture(timeout=max(2.0, 4 * interval))
+            if trigger == "arrival":
+                result = gauges.wait_set(0.25)
+                if result is None:
+                    continue
+            else:
+                result = gauges.capture(timeout=max(2.0, 4 * interval))
             while not events.empty():
                 _print_item(events.get_nowait(), jsonl, resolution)
             for channel in result.channels:
                 if channel in result.readings and (count is None or readings < count):
+                    note(result.readings[channel])
                     readings += _print_item(result.readings[channel], jsonl, resolution)
             continue
         now = time.monotonic()
@@ -253,6 +339,7 @@ def _loop(reader, gauges, events, trigger, count, interval, jsonl, resolution) -
             item = events.get(timeout=0.02)
         except queue.Empty:
             continue
+        note(item)
         is_reading = _print_item(item, jsonl, resolution)
         readings += is_reading
         answered += 1  # a rejected frame is an answer too

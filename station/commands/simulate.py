@@ -43,6 +43,16 @@ others):
                per second (default 200, as a counter's continuous output does):
                capture with --trigger push. The robot advances one point per
                set sent.
+
+--cycle-period S makes the fixture model's robot leave the fixture and come
+back every S seconds, as a playback loop does: at rest (the model's bias,
+noise, drift and backlash for that cycle), then the indicators run out to
+their free travel (--free-travel, default -3/8 in or -9.525 mm) while the
+robot is away, then it returns with a short overshoot (--overshoot, default
+20 resolutions) and settles. The c-th rest position is the model's c-th value;
+a reading shows where the robot is when it is sent. --hunt CH=V makes an axis
+hunt by +-V at rest on every --hunt-every N-th return instead of settling
+(a return the station must report, not record).
 """
 
 
@@ -117,6 +127,25 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     gauge.add_argument("--unit", default="mm", choices=("mm", "in"), help="unit (mm)")
     gauge.add_argument("--range", default="-12.5,12.5", metavar="LOW,HIGH", help="gauge range")
+    motion = parser.add_argument_group("motion (fixture model)")
+    motion.add_argument(
+        "--cycle-period",
+        metavar="S",
+        help="the robot leaves the fixture and returns every S seconds (default: it never "
+        "moves, each reading is a new rest position)",
+    )
+    motion.add_argument(
+        "--free-travel", metavar="V", help="what the indicators show while the robot is away"
+    )
+    motion.add_argument(
+        "--overshoot", metavar="V", help="how far past its rest position the robot returns"
+    )
+    motion.add_argument(
+        "--hunt", default="0", metavar="V", help="amplitude of an axis that hunts at rest (0)"
+    )
+    motion.add_argument(
+        "--hunt-every", default="1", metavar="N", help="the returns that hunt: every N-th (1)"
+    )
     line = parser.add_argument_group("line and faults")
     line.add_argument(
         "--push-rate",
@@ -266,7 +295,47 @@ def build_simulator(args: argparse.Namespace):
         push_rate = 200.0
     else:
         push_rate = 0.0 if protocol.polled else 1.0
-    return Simulator(protocol, model, faults, seed, push_rate=push_rate)
+    motion = build_motion(args, model, channels)
+    return Simulator(protocol, model, faults, seed, push_rate=push_rate, motion=motion)
+
+
+def build_motion(args: argparse.Namespace, model, channels: list[str]):
+    """The :class:`~station.instruments.motion.CycleMotion` of ``--cycle-period`` (None
+    without it)."""
+    from station.instruments.motion import CycleMotion, default_free_travel
+
+    motion_flags = [
+        flag
+        for flag, value in (
+            ("--free-travel", args.free_travel),
+            ("--overshoot", args.overshoot),
+        )
+        if value is not None
+    ]
+    if args.cycle_period is None:
+        if motion_flags:
+            raise StationError(f"{motion_flags[0]} needs --cycle-period (the robot's rhythm).")
+        return None
+    if args.model != "fixture":
+        raise StationError(
+            f"--cycle-period moves the fixture model's robot; the {args.model} model has its "
+            "own motion."
+        )
+    period = positive_number(args.cycle_period, "--cycle-period")
+    gauge = model.gauge(channels[0])
+    free = (
+        per_channel(args.free_travel, "--free-travel", channels)
+        if args.free_travel is not None
+        else default_free_travel(gauge.unit)
+    )
+    overshoot = (
+        _float(args.overshoot, "--overshoot")
+        if args.overshoot is not None
+        else 20 * gauge.resolution
+    )
+    hunt = {c: v for c, v in per_channel(args.hunt, "--hunt", channels).items() if v}
+    hunt_every = positive_number(args.hunt_every, "--hunt-every", int)
+    return CycleMotion(period, free, abs(overshoot), hunt=hunt, hunt_every=hunt_every)
 
 
 def show_pendant(simulator) -> None:
@@ -317,7 +386,13 @@ def run(args: argparse.Namespace) -> int:
         print(url, flush=True)
         print(
             f"station: simulating {', '.join(simulator.model.channels)} "
-            f"({simulator.protocol.name}) on {url}; Ctrl-C stops",
+            f"({simulator.protocol.name}) on {url}"
+            + (
+                f"; the robot leaves the fixture and returns every {simulator.motion.period:g} s"
+                if simulator.motion is not None
+                else ""
+            )
+            + "; Ctrl-C stops",
             file=sys.stderr,
             flush=True,
         )

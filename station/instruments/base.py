@@ -8,8 +8,13 @@ time and maps device channels to station channels (``x``, ``y``, ``z`` ...).
 
 from __future__ import annotations
 
+import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import ClassVar, Literal
+
+_DECIMALS = re.compile(rb"\.(\d+)")
 
 RejectReason = Literal["error", "status", "malformed", "out_of_range"]
 """Why a frame is not a reading: the device reported an error, it is a status/info frame, it
@@ -96,6 +101,11 @@ class Protocol:
 
     name: ClassVar[str]
     description: ClassVar[str]
+    carries_unit: ClassVar[bool] = False
+    """True when every data frame states its unit (mm or inch); else the session's applies."""
+    units_by_decimals: ClassVar[Mapping[int, str]] = MappingProxyType({})
+    """The unit this protocol's gauges usually show at a number of decimals (the Mitutoyo 01A
+    format: 3 in mm, 4 or 5 in inches); words the resolution check, never decides it."""
 
     settings: SerialSettings = field(default_factory=SerialSettings)
     terminator: bytes = b"\r"
@@ -122,3 +132,12 @@ class Protocol:
     def encode(self, device_channel: str, value: float, resolution: float, unit: str) -> bytes:
         """The frame (with terminator) a device sends for ``value``; the simulator speaks it."""
         raise NotImplementedError
+
+    def frame_decimals(self, frame: bytes) -> int | None:
+        """Digits after the decimal point of the value in a data ``frame`` (terminator
+        stripped): what resolution the gauge shows. None when the frame writes no point.
+
+        By default the digits after the last point followed by a digit; a protocol whose
+        frames write the point another way (the Digimatic point digit) overrides it."""
+        found = _DECIMALS.findall(frame)
+        return len(found[-1]) if found else None

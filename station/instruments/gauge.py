@@ -21,6 +21,15 @@ cables, or a mix) and turns their streams into reading sets by trigger:
   channel has a reading since the last set.
 * ``stable``: stream (polling continuously when the device is polled) and take the set once every
   channel has stayed within ``k`` × resolution for ``T`` ms.
+* ``arrival``: read continuously (a background thread polls a polled device); the robot's own
+  motion paces the cycles: a set is taken when the indicators have left their working band and
+  come back to rest (:mod:`station.instruments.arrival`). Sets go to ``on_set`` as push sets do;
+  a return that does not settle goes to ``on_arrival`` with a sentence, and is not a set.
+
+A zero takes several readings per channel over a settle window and refuses while a gauge moves
+(:mod:`station.instruments.zeroing`); the frames' decimals, steps and stated units are compared
+with the session's unit and resolution by :meth:`GaugeSet.check_frames`
+(:mod:`station.instruments.units`).
 
 No Textual here: the TUI wraps the callbacks (they run on reader threads).
 """
@@ -37,12 +46,21 @@ from dataclasses import dataclass, field, replace
 from typing import Literal
 
 from station.errors import StationError
+from station.instruments.arrival import ArrivalConfig, ArrivalDetector, ArrivalEvent
 from station.instruments.base import Protocol, Reading, Rejected, Rejection, SerialSettings
 from station.instruments.transport import open_port
+from station.instruments.units import (
+    FrameInference,
+    FrameSample,
+    frames_disagree,
+    infer_channel,
+    unit_mismatch,
+)
+from station.instruments.zeroing import DEFAULT_ZERO_STILL, ChannelZero, zero_from_readings
 
 State = Literal["connecting", "connected", "disconnected", "stopped"]
-Trigger = Literal["poll", "push", "stable"]
-TRIGGERS: tuple[str, ...] = ("poll", "push", "stable")
+Trigger = Literal["poll", "push", "stable", "arrival"]
+TRIGGERS: tuple[str, ...] = ("poll", "push", "stable", "arrival")
 
 DEFAULT_BACKOFF = (0.5, 5.0)
 """First retry delay and its cap, in seconds; the delay doubles between failed attempts."""
@@ -59,6 +77,9 @@ class GaugeReading(Reading):
 
     device_value: float = 0.0
     zero_offset: float = 0.0
+    frame_unit: str | None = None
+    """The unit the frame itself stated; None when it stated none (``unit`` is then the
+    session's)."""
 
 
 @dataclass(frozen=True)
@@ -430,6 +451,7 @@ class GaugeReader:
             port=self.url,
             device_value=parsed.value,
             zero_offset=offset,
+            frame_unit=parsed.unit,
         )
         self.reading_count += 1
         error = _call_quietly(self.on_reading, reading)
@@ -506,7 +528,8 @@ class CaptureResult:
             fresh_less = [
                 c for c in self.missing if c not in self.stale and c not in self.disconnected
             ]
-            if fresh_less:
+            # An arrival that did not happen is said by its error, not as silent gauges.
+            if fresh_less and (self.trigger != "arrival" or self.readings):
                 parts.append("no reading from " + ", ".join(fresh_less))
             if self.stale:
                 parts.append(
@@ -524,31 +547,8 @@ class CaptureResult:
         return "; ".join(parts) + "."
 
 
-def unit_mismatch(readings: Mapping[str, Reading], channels: Iterable[str], unit: str) -> str:
-    """'' when every one of ``channels`` in ``readings`` reads in ``unit``; else the sentence
-    (without a full stop) ``x, y read in mm but the session is in in``."""
-    other = {}
-    for channel in channels:
-        reading = readings.get(channel)
-        if reading is not None and reading.unit != unit:
-            other.setdefault(reading.unit, []).append(channel)
-    if not other:
-        return ""
-    parts = [
-        f"{', '.join(names)} {'reads' if len(names) == 1 else 'read'} in {other_unit}"
-        for other_unit, names in other.items()
-    ]
-    return "; ".join(parts) + f" but the session is in {unit}"
-
-
-@dataclass(frozen=True)
-class ZeroResult:
-    """How one channel was zeroed: the device's own command, or a software offset."""
-
-    channel: str
-    method: Literal["device", "software"]
-    offset: float
-    """The device value subtracted from later readings (0.0 for a device zero)."""
+ZeroResult = ChannelZero
+"""How one channel was zeroed (:class:`~station.instruments.zeroing.ChannelZero`)."""
 
 
 class Subscription:
@@ -567,8 +567,11 @@ class GaugeSet:
 
     ``resolution`` (one number or one per channel) and ``stable_k``/``stable_ms`` define the
     ``stable`` trigger; ``poll_interval`` is how often a polled device is asked while streaming.
-    ``on_set`` receives each completed push set (on a reader thread); :meth:`wait_set` returns
-    them in order. The callbacks and ``events`` go to every reader.
+    ``on_set`` receives each completed push or arrival set (on a reader thread); :meth:`wait_set`
+    returns them in order. ``arrival`` configures the ``arrival`` trigger (defaults otherwise);
+    ``on_arrival`` receives its other events (departed, returned, and ``unsettled`` with its
+    sentence in ``message``), on a reader or the streaming thread. The callbacks and ``events``
+    go to every reader.
     """
 
     def __init__(
@@ -588,6 +591,8 @@ class GaugeSet:
         events: queue.Queue | None = None,
         backoff: tuple[float, float] = DEFAULT_BACKOFF,
         history: int = 256,
+        arrival: ArrivalConfig | None = None,
+        on_arrival: Callable[[ArrivalEvent], object] | None = None,
     ) -> None:
         if trigger not in TRIGGERS:
             raise StationError(f"Unknown trigger {trigger!r}: use one of {', '.join(TRIGGERS)}.")
@@ -638,18 +643,64 @@ class GaugeSet:
         self._pending_duplicated: set[str] = set()
         self._sets: deque[CaptureResult] = deque(maxlen=64)
         self._push_armed_at = 0.0
+        self.on_arrival = on_arrival
+        self.arrival_config = arrival or ArrivalConfig()
+        self._detector: ArrivalDetector[GaugeReading] | None = (
+            ArrivalDetector(self.channels, self.resolution, self.arrival_config)
+            if trigger == "arrival"
+            else None
+        )
+        self._collectors: list[dict[str, list[GaugeReading]]] = []
+        self._streaming = threading.Event()
+        self._stream_thread: threading.Thread | None = None
 
     # -- life cycle ----------------------------------------------------------------------
 
     def start(self) -> None:
-        """Start every reader (each connects in the background)."""
+        """Start every reader (each connects in the background); with the ``arrival`` trigger
+        also the thread that polls continuously and keeps the detector's clock."""
         for reader in self.readers:
             reader.start()
+        if self._detector is not None and self._stream_thread is None:
+            self._streaming.set()
+            self._stream_thread = threading.Thread(
+                target=self._stream, name="gauge-set arrival", daemon=True
+            )
+            self._stream_thread.start()
 
     def stop(self) -> None:
         """Stop every reader; returns within about a second."""
+        self._streaming.clear()
+        if self._stream_thread is not None:
+            self._stream_thread.join(1.0)
+            self._stream_thread = None
         for reader in self.readers:
             reader.stop(timeout=1.0)
+
+    def _stream(self) -> None:
+        """The ``arrival`` trigger's thread: poll every polled port each ``poll_interval``
+        (no flush: every answer counts; no pile-up: one request in flight per port) and tell
+        the detector the time, so a return that never settles is reported even when the line
+        goes quiet."""
+        in_flight: dict[GaugeReader, TriggerTicket] = {}
+        while self._streaming.is_set():
+            for reader in self.readers:
+                if not reader.protocol.polled or reader.state != "connected":
+                    continue
+                ticket = in_flight.get(reader)
+                if ticket is None or ticket.done.is_set():
+                    in_flight[reader] = reader.trigger(True, flush=False)
+            with self._changed:
+                events = self._detector.tick(time.monotonic()) if self._detector else []
+            self._deliver_arrival(events)
+            time.sleep(self.poll_interval)
+
+    @property
+    def arrival_state(self) -> str:
+        """Where the ``arrival`` trigger thinks the robot is: ``waiting`` (at the fixture, or
+        not yet seen leaving), ``away`` or ``returned`` (back, waiting for stillness); '' for
+        another trigger."""
+        return self._detector.state if self._detector is not None else ""
 
     def __enter__(self) -> GaugeSet:
         self.start()
@@ -706,21 +757,53 @@ class GaugeSet:
 
     def _on_reading(self, reading: GaugeReading) -> None:
         completed = None
+        arrival: list[ArrivalEvent] = []
         with self._changed:
             history = self._history.get(reading.channel)
             if history is not None:
                 history.append(reading)
+                for collector in self._collectors:
+                    collector[reading.channel].append(reading)
                 if self.trigger == "push" and reading.t_mono >= self._push_armed_at:
                     completed = self._add_to_push_set(reading)
+                elif self._detector is not None and reading.t_mono >= self._push_armed_at:
+                    arrival = self._detector.feed(
+                        reading.channel, reading.value, reading.t_mono, reading
+                    )
+                    completed = self._arrival_set(arrival)
             self._changed.notify_all()
         if completed is not None:
             for listener in (self.on_set, *self._set_listeners):
                 error = _call_quietly(listener, completed)
                 if error is not None:
                     self.readers[0].report(f"set callback failed: {error!r}")
+        self._deliver_arrival(arrival)
         error = _call_quietly(self.on_reading, reading)
         if error is not None:
             raise error  # GaugeReader reports it as a status message
+
+    def _arrival_set(self, events: list[ArrivalEvent]) -> CaptureResult | None:
+        """The set of a ``settled`` event, queued for :meth:`wait_set`. Lock held."""
+        for event in events:
+            if event.kind == "settled":
+                result = CaptureResult(
+                    "arrival",
+                    self.channels,
+                    dict(event.readings),
+                    t_trigger=event.t_arrived if event.t_arrived is not None else event.t,
+                )
+                self._sets.append(result)
+                return result
+        return None
+
+    def _deliver_arrival(self, events: list[ArrivalEvent]) -> None:
+        """Hand the detector's events other than a set to ``on_arrival`` (no lock held)."""
+        for event in events:
+            if event.kind == "settled":
+                continue
+            error = _call_quietly(self.on_arrival, event)
+            if error is not None:
+                self.readers[0].report(f"arrival callback failed: {error!r}")
 
     def _add_to_push_set(self, reading: GaugeReading) -> CaptureResult | None:
         if not self._pending and len(self.readers) == 1 and reading.channel != self.channels[0]:
@@ -793,9 +876,33 @@ class GaugeSet:
             with self._changed:
                 partial = dict(self._pending)
             return self._result("push", partial, self._push_armed_at, {}, errors)
+        if self.trigger == "arrival":
+            return self._capture_arrival(timeout)
         if self.trigger == "poll":
             return self._capture_poll(timeout)
         return self._capture_stable(timeout)
+
+    def _capture_arrival(self, timeout: float) -> CaptureResult:
+        """The next arrival set after now (the robot must leave and come back to rest)."""
+        start = time.monotonic()
+        errors = self.arm(timeout)
+        result = self.wait_set(max(0.0, timeout - (time.monotonic() - start)))
+        if result is not None:
+            return result
+        waiting = {
+            "waiting": "the robot did not leave the fixture",
+            "away": "the robot did not come back",
+            "returned": "the robot came back but did not settle",
+        }[self.arrival_state or "waiting"]
+        return CaptureResult(
+            "arrival",
+            self.channels,
+            {},
+            missing=self.channels,
+            errors=(*errors, f"{waiting} within {timeout:g} s"),
+            t_trigger=start,
+            disconnected=tuple(c for c in self.channels if self._reader_of[c].state != "connected"),
+        )
 
     def _capture_poll(self, timeout: float) -> CaptureResult:
         deadline = time.monotonic() + timeout
@@ -905,6 +1012,7 @@ class GaugeSet:
 
     def arm(self, timeout: float = 1.0) -> list[str]:
         """Push: forget partial and completed sets and buffered input; later readings count.
+        Arrival: the same, and only a departure after now starts a cycle.
 
         Returns the port problems met (empty when every port took the trigger). Call it when
         the operator is asked to press DATA, then :meth:`wait_set`.
@@ -915,6 +1023,9 @@ class GaugeSet:
             self._pending.clear()
             self._pending_duplicated.clear()
             self._sets.clear()
+            if self._detector is not None:
+                # Only a departure after this counts: a robot already back is not a cycle.
+                self._detector.reset()
         return errors
 
     def set_zero_offsets(self, offsets: Mapping[str, float]) -> None:
@@ -958,13 +1069,22 @@ class GaugeSet:
         timeout: float = 2.0,
         *,
         unit: str | None = None,
-    ) -> list[ZeroResult]:
+        readings: int = 1,
+        settle: float = 0.0,
+        still: float = DEFAULT_ZERO_STILL,
+    ) -> list[ChannelZero]:
         """Zero ``channels`` (all by default): the device's command, else a software offset.
 
-        A software zero takes a fresh reading set (by this set's trigger) and subtracts each
-        channel's device value from its later readings; with ``unit`` it refuses (nothing
-        zeroed) when a channel reads in another unit. A port that is down is waited for until
-        ``timeout``.
+        With ``readings`` > 1 every channel is read ``readings`` times over ``settle`` seconds
+        (:meth:`collect`); the zero is refused (StationError naming the channel, nothing
+        zeroed) while a channel's readings spread over more than ``still`` resolutions or too
+        few arrive. Then a software channel's offset is the mean of its readings and a device
+        channel gets its zero command. With ``readings`` = 1 (the old way) a software zero takes
+        one fresh reading set and a device zero reads nothing. With ``unit`` it refuses a
+        channel reading in another unit. A port that is down is waited for until ``timeout``
+        (counted after the settle window). Returns one
+        :class:`~station.instruments.zeroing.ChannelZero` per channel, in ``channels``' order:
+        its :meth:`~station.instruments.zeroing.ChannelZero.record` is the zero event's entry.
         """
         wanted = list(self.channels if channels is None else channels)
         unknown = [c for c in wanted if c not in self._reader_of]
@@ -973,27 +1093,82 @@ class GaugeSet:
                 f"Cannot zero {', '.join(unknown)}: this station's channels are "
                 f"{', '.join(self.channels)}."
             )
-        deadline = time.monotonic() + timeout
-        results: list[ZeroResult] = []
-        software = []
-        for channel in wanted:
-            reader = self._reader_of[channel]
-            device_channel = next(
-                d for d in reader.device_channels if reader.station_channel(d) == channel
+        if readings < 1:
+            raise StationError(f"A zero needs at least 1 reading per channel, not {readings}.")
+        commands = {c: self._zero_command(c) for c in wanted}
+        if readings == 1:
+            return self._zero_once(wanted, commands, timeout, unit)
+        taken = self.collect(wanted, readings, settle, timeout)
+        down = [
+            c
+            for c in wanted
+            if len(taken[c]) < readings and self._reader_of[c].state != "connected"
+        ]
+        if down:
+            reader = self._reader_of[down[0]]
+            raise StationError(
+                f"Could not zero {', '.join(down)}: {reader._down_message()}. Check the cable "
+                "and try again."
             )
-            command = reader.protocol.zero_command(device_channel)
-            if command:
+        if unit is not None:
+            latest = {c: values[-1] for c, values in taken.items() if values}
+            mismatch = unit_mismatch(latest, wanted, unit)
+            if mismatch:
+                raise StationError(f"Could not zero: {mismatch}.")
+        spans = [v[-1].t_mono - v[0].t_mono for v in taken.values() if v]
+        zeros = zero_from_readings(
+            {c: [r.device_value for r in taken[c]] for c in wanted},
+            self.resolution,
+            methods={c: "device" if commands[c] else "software" for c in wanted},
+            min_readings=readings,
+            still=still,
+            window=max(spans, default=0.0),
+            unit=unit or "",
+        )
+        self._apply_zeros(zeros, commands, timeout)
+        return list(zeros)
+
+    def _zero_command(self, channel: str) -> bytes | None:
+        reader = self._reader_of[channel]
+        device_channel = next(
+            d for d in reader.device_channels if reader.station_channel(d) == channel
+        )
+        return reader.protocol.zero_command(device_channel)
+
+    def _apply_zeros(
+        self,
+        zeros: Iterable[ChannelZero],
+        commands: Mapping[str, bytes | None],
+        timeout: float,
+    ) -> None:
+        """Send the device zero commands and set the software offsets."""
+        deadline = time.monotonic() + timeout
+        for zero in zeros:
+            reader = self._reader_of[zero.channel]
+            command = commands[zero.channel]
+            if zero.method == "device" and command:
                 # A short dropout is waited out, as a capture waits for it.
                 if not reader.wait_connected(max(0.0, deadline - time.monotonic())):
                     raise StationError(
-                        f"Could not zero {channel}: {reader._down_message()}. Check the cable "
-                        "and try again."
+                        f"Could not zero {zero.channel}: {reader._down_message()}. Check the "
+                        "cable and try again."
                     )
                 reader.send(command)
-                reader.set_zero_offset(channel, 0.0)
-                results.append(ZeroResult(channel, "device", 0.0))
+                reader.set_zero_offset(zero.channel, 0.0)
             else:
-                software.append(channel)
+                reader.set_zero_offset(zero.channel, zero.offset)
+
+    def _zero_once(
+        self,
+        wanted: list[str],
+        commands: Mapping[str, bytes | None],
+        timeout: float,
+        unit: str | None,
+    ) -> list[ChannelZero]:
+        """The zero from one reading: a device zero reads nothing, a software zero one set."""
+        deadline = time.monotonic() + timeout
+        zeros = {c: ChannelZero(c, "device", 0.0, 0) for c in wanted if commands[c]}
+        software = [c for c in wanted if not commands[c]]
         if software:
             result = self.capture(max(0.0, deadline - time.monotonic()))
             absent = [c for c in software if c not in result.readings]
@@ -1008,7 +1183,115 @@ class GaugeSet:
                 if mismatch:
                     raise StationError(f"Could not zero: {mismatch}.")
             for channel in software:
-                offset = result.readings[channel].device_value
-                self._reader_of[channel].set_zero_offset(channel, offset)
-                results.append(ZeroResult(channel, "software", offset))
-        return sorted(results, key=lambda z: wanted.index(z.channel))
+                value = result.readings[channel].device_value
+                zeros[channel] = ChannelZero(
+                    channel, "software", value, 1, value, 0.0, (value,), self.resolution[channel]
+                )
+        ordered = [zeros[c] for c in wanted]
+        self._apply_zeros(ordered, commands, max(0.0, deadline - time.monotonic()))
+        return ordered
+
+    def collect(
+        self,
+        channels: Iterable[str] | None = None,
+        readings: int = 10,
+        settle: float = 1.0,
+        timeout: float = 2.0,
+    ) -> dict[str, list[GaugeReading]]:
+        """Read ``channels`` until each has ``readings`` readings and ``settle`` seconds have
+        passed (or ``settle`` + ``timeout`` seconds, whichever first); the readings by channel.
+
+        A polled port is asked every ``settle / (readings − 1)`` seconds (never faster than
+        every 10 ms, no input flushed, one request in flight); a pushing port is listened to
+        (a streaming device sends by itself; a DATA button must be pressed ``readings``
+        times). With the ``arrival`` trigger the streaming thread's polls count too. Only
+        readings that arrive after the call count."""
+        wanted = list(self.channels if channels is None else channels)
+        collector: dict[str, list[GaugeReading]] = {c: [] for c in self.channels}
+        interval = max(0.01, settle / max(readings - 1, 1))
+        start = time.monotonic()
+        deadline = start + settle + timeout
+        polled = {self._reader_of[c] for c in wanted if self._reader_of[c].protocol.polled}
+        in_flight: dict[GaugeReader, TriggerTicket] = {}
+        with self._changed:
+            self._collectors.append(collector)
+        try:
+            next_poll = start
+            while True:
+                now = time.monotonic()
+                with self._changed:
+                    enough = all(len(collector[c]) >= readings for c in wanted)
+                if (enough and now - start >= settle) or now >= deadline:
+                    break
+                if now >= next_poll and not (
+                    self._stream_thread and self.poll_interval <= interval
+                ):
+                    for reader in polled:
+                        ticket = in_flight.get(reader)
+                        if reader.state == "connected" and (ticket is None or ticket.done.is_set()):
+                            in_flight[reader] = reader.trigger(True, flush=False)
+                    next_poll = now + interval
+                with self._changed:
+                    self._changed.wait(max(0.0, min(next_poll, deadline) - time.monotonic()))
+        finally:
+            with self._changed:
+                self._collectors.remove(collector)
+        return {c: list(collector[c]) for c in wanted}
+
+    # -- what the frames say -------------------------------------------------------------
+
+    def frame_samples(self, channels: Iterable[str] | None = None) -> dict[str, list[FrameSample]]:
+        """What the kept readings' frames show, per channel: the device value (before any
+        software zero), the decimals written and the unit stated."""
+        wanted = list(self.channels if channels is None else channels)
+        with self._changed:
+            kept = {c: list(self._history[c]) for c in wanted}
+        samples: dict[str, list[FrameSample]] = {}
+        for channel, readings in kept.items():
+            protocol = self._reader_of[channel].protocol
+            samples[channel] = [
+                FrameSample(
+                    r.device_value,
+                    protocol.frame_decimals(r.raw.encode("ascii", "backslashreplace")),
+                    r.frame_unit,
+                )
+                for r in readings
+            ]
+        return samples
+
+    def infer_frames(self, channels: Iterable[str] | None = None) -> dict[str, FrameInference]:
+        """The unit and resolution each channel's kept frames show (:func:`infer_channel`)."""
+        return {
+            channel: infer_channel(
+                channel, samples, self._reader_of[channel].protocol.units_by_decimals
+            )
+            for channel, samples in self.frame_samples(channels).items()
+        }
+
+    def check_frames(
+        self,
+        unit: str,
+        resolution: float | Mapping[str, float] | None = None,
+        *,
+        readings: int = 5,
+        timeout: float = 2.0,
+        channels: Iterable[str] | None = None,
+    ) -> str:
+        """'' when the frames agree with ``unit`` and ``resolution`` (default: this set's);
+        else the sentence naming both (no full stop), e.g. "the gauges send steps of 0.001,
+        which is mm on this protocol; the session is in inches at 0.0001".
+
+        Reads up to ``readings`` more readings per channel first (:meth:`collect`, no settle
+        window; a push device that is not pressed gives none within ``timeout``), then judges
+        every kept frame. A channel that sent nothing says nothing.
+        """
+        wanted = list(self.channels if channels is None else channels)
+        self.collect(wanted, readings, 0.0, timeout)
+        samples = self.frame_samples(wanted)
+        inferred = {
+            c: infer_channel(c, samples[c], self._reader_of[c].protocol.units_by_decimals)
+            for c in wanted
+        }
+        return frames_disagree(
+            inferred, unit, self.resolution if resolution is None else resolution, samples
+        )

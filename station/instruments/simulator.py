@@ -14,7 +14,10 @@ Two halves, so later procedures add models without touching the server:
 
 Determinism: the k-th reading of a channel depends only on the seed and k (each value draws from
 its own generator seeded with ``(seed, channel index, k)``); fault decisions come from one
-generator seeded with the seed, in the order frames are sent.
+generator seeded with the seed, in the order frames are sent. A *moving* simulator
+(``motion``, a :class:`~station.instruments.motion.CycleMotion`) shows the robot's round trips
+instead: what a reading shows depends on when it is sent, and the c-th rest position is the
+model's c-th value.
 
 Disconnect and return on a pty: closing the master makes the reader see EIO /
 ``SerialException`` at once, but the kernel then removes ``/dev/pts/N``, and the next pty may get
@@ -44,6 +47,7 @@ from pathlib import Path
 
 from station.errors import StationError
 from station.instruments.base import Protocol
+from station.instruments.motion import CycleMotion
 
 # Garbage is drawn from bytes no protocol reads as a value (no digits, signs, points or letters
 # that start a frame), so a garbage line is always a rejection, never a reading.
@@ -230,6 +234,8 @@ class SentFrame:
     value: float
     frame: bytes
     t_mono: float
+    cycle: int | None = None
+    """The robot's cycle when it was sent (a moving simulator); None otherwise."""
 
 
 @dataclass
@@ -277,12 +283,18 @@ class Simulator:
         channel_map: Mapping[str, str] | None = None,
         push_rate: float = 0.0,
         answer_delay: float = 0.0,
+        motion: CycleMotion | None = None,
     ) -> None:
         self.protocol = protocol
         self.model = model
         self.faults = faults or Faults()
         self.seed = seed
         self.push_rate = push_rate
+        self.motion = motion
+        """The robot's round trips (:mod:`~station.instruments.motion`); None: every reading is
+        a new rest position (the k-th reading of the model)."""
+        self.motion_t0 = 0.0
+        """``time.monotonic()`` when serving started: the origin of the motion's time."""
         self.answer_delay = answer_delay
         if channel_map is None:
             own = tuple(protocol.channels)
@@ -393,6 +405,7 @@ class Simulator:
 
     def _start_thread(self) -> None:
         self._stopping.clear()
+        self.motion_t0 = time.monotonic()
         self._thread = threading.Thread(target=self._serve, name="gauge-simulator", daemon=True)
         self._thread.start()
 
@@ -701,7 +714,13 @@ class Simulator:
         channel = self.channel_map[device]
         gauge = self.model.gauge(channel)
         k = self._k[channel]
-        value = self.expected(channel, k)
+        now = time.monotonic()
+        cycle = None
+        if self.motion is not None:
+            cycle = self.motion.stage(now - self.motion_t0)[0]
+            value = self.expected_at(channel, now)
+        else:
+            value = self.expected(channel, k)
         frame = self.protocol.encode(device, value, gauge.resolution, gauge.unit)
         if garbage:
             noise = bytes(
@@ -719,7 +738,7 @@ class Simulator:
         if not delivered:
             return  # the line is down: this value was never seen, and k is not used up
         self._k[channel] = k + 1
-        self.sent[channel].append(SentFrame(channel, k, value, frame, time.monotonic()))
+        self.sent[channel].append(SentFrame(channel, k, value, frame, time.monotonic(), cycle))
         if self.on_sent is not None:
             self.on_sent(channel, k)
         if stale and self._recent:
@@ -739,7 +758,39 @@ class Simulator:
     def _zero(self, channel: str) -> None:
         """The device's zero key: what it shows now (its last reading) becomes 0."""
         self.zero_requests.append(channel)
+        if self.motion is not None:
+            # A moving robot's gauge zeroes on what it shows at this instant.
+            self.zero_offsets[channel] = self.shown_at(channel, time.monotonic())
+            return
         self.zero_offsets[channel] = self.model.zero_reference(channel, self._k[channel], self.seed)
+
+    def rest_value(self, channel: str, cycle: int) -> float:
+        """Where ``channel``'s indicator comes to rest in ``cycle`` (a moving simulator), as
+        the gauge shows it before any zero: the model's ``cycle``-th value."""
+        return self.model.value(channel, cycle, self.seed)
+
+    def shown_at(self, channel: str, t_mono: float) -> float:
+        """What ``channel``'s gauge shows at ``t_mono`` (a moving simulator), before any zero."""
+        motion = self.motion
+        if motion is None:
+            raise StationError("this simulator does not move (no cycle period)")
+        cycle = motion.stage(t_mono - self.motion_t0)[0]
+        exact = getattr(self.model, "true_value", self.model.value)
+        position = motion.position(
+            channel,
+            t_mono - self.motion_t0,
+            exact(channel, cycle, self.seed),
+            exact(channel, cycle + 1, self.seed),
+        )
+        return self.model.gauge(channel).show(position)
+
+    def expected_at(self, channel: str, t_mono: float) -> float:
+        """What ``channel``'s gauge shows at ``t_mono`` after any zeroing (a moving simulator)."""
+        value = self.shown_at(channel, t_mono)
+        offset = self.zero_offsets.get(channel)
+        if offset is None:
+            return value
+        return self.model.gauge(channel).show(value - offset)
 
     def sent_values(self, channel: str) -> list[float]:
         """The values sent so far on ``channel``, in order."""

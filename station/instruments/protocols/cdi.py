@@ -27,6 +27,7 @@ class ChicagoDialIndicator(GaugeProtocol):
 
     name = "cdi"
     description = "Chicago Dial Indicator USB/RS-232 (R to read, C to zero)"
+    carries_unit = True
 
     settings: SerialSettings = field(default_factory=lambda: SerialSettings(9600, 8, "N", 1))
     terminator: bytes = b"\r\n"

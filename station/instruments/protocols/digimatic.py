@@ -39,7 +39,15 @@ class DigimaticText(GaugeProtocol):
     name = "digimatic"
     description = "Digimatic 13-digit frame as text from a bit-level adaptor (FFFF000012330)"
 
+    carries_unit = True
     terminator: bytes = b"\r"
+
+    def frame_decimals(self, frame: bytes) -> int | None:
+        """The point-position digit (d12): ``FFFF000012330`` -> 3."""
+        frame = frame.replace(b" ", b"")
+        if len(frame) != _FRAME_LENGTH or not 48 <= frame[11] <= 53:
+            return None
+        return frame[11] - 48
 
     def parse(self, frame: bytes) -> Value | Rejected:
         """``FFFF021076540`` -> +21.0765 mm; ``FFFF801234530`` -> -12.345 mm."""

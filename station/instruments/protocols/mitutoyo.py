@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from types import MappingProxyType
 
 from station.instruments.base import Rejected, RejectReason, SerialSettings, Value
 from station.instruments.protocols.common import GaugeProtocol, format_magnitude, malformed
@@ -39,6 +40,9 @@ class Mitutoyo(GaugeProtocol):
     settings: SerialSettings = field(default_factory=lambda: SerialSettings(9600, 8, "N", 1))
     terminator: bytes = b"\r"
     request_template: bytes | None = b"1\r"
+    units_by_decimals = MappingProxyType({3: "mm", 4: "in", 5: "in"})
+    """0.123 mm at 0.001 -> ``0000.123``; 0.1234 in -> ``000.1234``; 0.12345 in ->
+    ``00.12345`` (QM-Height manual §6.3): the usual decimals per unit, for wording."""
 
     def parse(self, frame: bytes) -> Value | Rejected:
         """``01A+0000.123`` -> Value("1", 0.123); ``9…`` -> error; ``1…`` -> status."""

@@ -55,6 +55,7 @@ class UWave(GaugeProtocol):
     name = "uwave"
     description = "Mitutoyo U-WAVE-R wireless receiver (push)"
 
+    carries_unit = True
     settings: SerialSettings = field(default_factory=lambda: SerialSettings(57600, 8, "N", 1))
     terminator: bytes = b"\r"
 

@@ -21,7 +21,7 @@ class ZeroStep(StepHandler):
     """Done when the ``zero`` event (per channel: method and offset) is on disk."""
 
     kind = "zero"
-    schema = StepSchema(channels=True)
+    schema = StepSchema(channels=True, zero_window=True)
     confirm_waits = True
 
     def action(self, run: Runner, item: PlanItem) -> Action:

@@ -1,0 +1,80 @@
+"""The procedure file's arrival trigger and zero-step settings: defaults, values, faults."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from station.errors import StationError
+from station.instruments.arrival import ArrivalConfig
+from station.procedures import builtin_procedures_dir, load_procedure
+
+HEAD = """
+id = "probe"
+title = "Probe"
+version = "1"
+report_section = "2.6"
+channels = ["x", "y", "z"]
+unit = "in"
+resolution = 0.0001
+"""
+ZERO = """
+[[steps]]
+id = "zero"
+kind = "zero"
+title = "Zero"
+text = "Keep the robot still and zero."
+"""
+
+
+def write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "probe.toml"
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def test_without_settings_the_defaults_apply(tmp_path: Path) -> None:
+    procedure = load_procedure(write(tmp_path, HEAD + ZERO))
+    assert procedure.arrival == ArrivalConfig()
+    zero = procedure.steps[0]
+    assert (zero.readings, zero.settle, zero.still) == (10, 1.0, 3.0)
+
+
+def test_the_files_settings_are_kept(tmp_path: Path) -> None:
+    text = (
+        HEAD
+        + "\n[arrival]\nband = 0.02\nstill = 3\nsettle = 0.8\ntimeout = 15\n"
+        + ZERO
+        + "readings = 20\nsettle = 2.5\nstill = 4\n"
+    )
+    procedure = load_procedure(write(tmp_path, text))
+    assert procedure.arrival == ArrivalConfig(band=0.02, still=3, settle=0.8, timeout=15)
+    zero = procedure.steps[0]
+    assert (zero.readings, zero.settle, zero.still) == (20, 2.5, 4.0)
+
+
+@pytest.mark.parametrize(
+    ("extra", "zero_extra", "fault"),
+    [
+        ("\n[arrival]\nwait = 2\n", "", r"\[arrival\]: unknown key\(s\) 'wait'"),
+        ("\n[arrival]\nband = -1\n", "", r"\[arrival\]: 'band' must be greater than 0"),
+        ("\n[arrival]\nsettle = 20\n", "", r"\[arrival\]: The arrival timeout \(10 s\) must"),
+        ("", "readings = 1\n", r"step 1 \(zero\): 'readings' must be 2 or more"),
+        ("", "settle = 0\n", r"step 1 \(zero\): 'settle' must be greater than 0"),
+        ("", "readings = 2.5\n", r"step 1 \(zero\): 'readings' must be an integer"),
+    ],
+)
+def test_faults_name_the_file_and_the_place(tmp_path: Path, extra, zero_extra, fault) -> None:
+    path = write(tmp_path, HEAD + extra + ZERO + zero_extra)
+    with pytest.raises(StationError, match=fault) as caught:
+        load_procedure(path)
+    assert str(path) in caught.value.message
+
+
+def test_the_builtin_procedures_zero_from_several_readings() -> None:
+    for path in sorted(builtin_procedures_dir().glob("*.toml")):
+        for step in load_procedure(path).all_steps():
+            if step.kind == "zero":
+                assert step.readings and step.readings > 1, path.name
