@@ -141,35 +141,43 @@ class JointsAnalysis:
         }
 
     def lines(self, unit: str = "") -> list[str]:
-        """The report block: the ranking table, the tests and the verdict."""
-        suffix = f" {unit}" if unit else ""
+        """The report block: the ranking table, the tests and the verdict (at most 80
+        columns)."""
+        import textwrap
+
+        angular = all(j.angular_spread is not None for j in self.joints)
         lines = [
             "PER-JOINT TROUBLESHOOTING (each joint moved alone, the others held)",
-            f"  rank joint   n   share  3-D spread{suffix:<4}"
-            "  offset x / y / z            a1     alternation",
+            f"  ranked by share of the {'angular ' if angular else ''}variance; spread: 3-D σ"
+            + (f" ({unit})" if unit else "")
+            + ("; angular: µrad" if angular else ""),
+            "  joint   n  share    spread"
+            + (" angular" if angular else "")
+            + "  offset x / y / z           a1  odd-even",
         ]
         for j in self.joints:
-            offsets = " / ".join(f"{j.offset[a]:+.5f}" for a in AXES)
-            skew = "n/a" if j.skewness is None else f"{j.skewness:+.2f}"
-            alt = (
-                "n/a"
-                if j.alternation is None
-                else f"{j.alternation:+.2f} (p {j.alternation_p:.3g})"
-            )
+            offsets = "/".join(f"{j.offset[a]:+.5f}" for a in AXES)
+            skew = "  n/a" if j.skewness is None else f"{j.skewness:+5.2f}"
+            alt = "   n/a" if j.alternation is None else f"{j.alternation:+6.2f}"
+            micro = f" {1e6 * j.angular_spread:7.2f}" if angular else ""  # type: ignore[operator]
             lines.append(
-                f"  {j.rank:4d} {j.joint:5d} {j.n:3d} {100 * j.share:6.1f} %  {j.spread:10.6f}"
-                f"  {offsets}  {skew:>6}  {alt}"
+                f"  {j.joint:5d} {j.n:3d} {100 * j.share:5.1f} % {j.spread:9.6f}"
+                f"{micro}  {offsets}  {skew}  {alt}"
             )
         if self.levene_p is not None:
             lines.append(
                 f"  spreads between joints: Levene (median) p = {self.levene_p:.3g}, "
                 f"Bartlett p = {self.bartlett_p:.3g}"
             )
-        if self.suspect is None:
-            lines.append(f"  SUSPECT: none. {self.reason}")
-        else:
-            lines.append(f"  SUSPECT: joint {self.suspect}. {self.reason}")
-            lines.append(f"  Reading: {self.reading}")
+        verdict = (
+            f"SUSPECT: none. {self.reason}"
+            if self.suspect is None
+            else f"SUSPECT: joint {self.suspect}. {self.reason}"
+        )
+        wrap = {"width": 80, "initial_indent": "  ", "subsequent_indent": "    "}
+        lines.extend(textwrap.wrap(verdict, **wrap))  # type: ignore[arg-type]
+        if self.reading is not None:
+            lines.extend(textwrap.wrap(f"Reading: {self.reading}", **wrap))  # type: ignore[arg-type]
         return lines
 
 

@@ -52,6 +52,10 @@ others):
                --fault-size radians; the healthy joints repeat to 5e-6 rad.
                Printed on stderr as "joint J: ..." when the next joint's turn
                comes, with its lever arm.
+  gauge-bench  the gauge check (Type-1 study): one indicator x in inches over
+               a surface plate (zeroing reads the plate), a gauge block of
+               --reference size re-seated for every reading, read with the
+               indicator's --bias and --noise (default 0.00003).
 """
 
 
@@ -77,10 +81,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--link", metavar="PATH", help="pty: also make PATH a symlink to it")
     parser.add_argument(
         "--model",
-        choices=("fixture", "two-fixture", "bar", "joints"),
+        choices=("fixture", "two-fixture", "bar", "joints", "gauge-bench"),
         default="fixture",
         help="the set-up: fixture (repeatability, default), two-fixture (relative accuracy), "
-        "bar (linearity) or joints (per-joint troubleshooting)",
+        "bar (linearity), joints (per-joint troubleshooting) or gauge-bench (gauge check)",
     )
     parser.add_argument("--channels", default="x,y,z", help="station channels (default x,y,z)")
     parser.add_argument("--seed", default="0", help="random seed (default 0)")
@@ -132,6 +136,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     joints.add_argument(
         "--cycles-per-joint", default="25", metavar="N", help="returns per joint (25)"
     )
+    bench = parser.add_argument_group("gauge-bench model (gauge check)")
+    bench.add_argument("--reference", default="0.1", metavar="V", help="gauge block size (0.1)")
     gauge = parser.add_argument_group("gauge")
     gauge.add_argument(
         "--resolution", help="gauge resolution (0.001; two-fixture and bar 0.0001 in)"
@@ -197,6 +203,15 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
     if args.model == "fixture":
         return None
     resolution = positive_number(args.resolution, "--resolution")
+    if args.model == "gauge-bench":
+        from station.instruments.gauge_bench import GaugeBenchModel
+
+        bias = per_channel(args.bias, "--bias", ["x"])["x"]
+        noise = per_channel(args.noise, "--noise", ["x"])["x"]
+        reference = _float(args.reference, "--reference")
+        return GaugeBenchModel(
+            reference, bias=bias, noise=noise, gauge=GaugeSpec(resolution, -0.5, 1.0, "in")
+        )
     if args.model == "joints":
         from station.instruments.joint_model import JointModel, faulty_arm
 
@@ -268,6 +283,7 @@ def build_simulator(args: argparse.Namespace):
             "two-fixture": "0.0002",
             "bar": "0.00005",
             "joints": "0",
+            "gauge-bench": "0.00003",
         }[args.model]
     channels = [c.strip() for c in args.channels.split(",") if c.strip()]
     if not channels or len(set(channels)) != len(channels):

@@ -141,6 +141,11 @@ class JointModel(RobotModel):
         """The k-th displayed reading of ``channel``."""
         return self._gauge.show(self.true_value(channel, k, seed))
 
+    def zero_reference(self, channel: str, k_next: int, seed: int) -> float:
+        """A device zero with the cube at the taught position, before the joint moves: the
+        indicators' zero is that position."""
+        return 0.0
+
     def table(self, seed: int = 0) -> list[tuple[int, float, float, float]]:
         """Rows ``(joint, x, y, z)`` of a whole run (what ``station analyze --procedure
         joint_troubleshooting`` reads from a CSV)."""
