@@ -328,3 +328,28 @@ def session_gauges(header: Mapping[str, Any]) -> dict[str, str]:
     if not isinstance(recorded, Mapping):
         return {}
     return {str(channel): str(gauge) for channel, gauge in recorded.items()}
+
+
+def verdict_lines(
+    header: Mapping[str, Any],
+    today: dt.date,
+    *,
+    path: Path | None = None,
+    valid_days: int = VALID_DAYS,
+) -> list[str]:
+    """The gauge lines of a repeatability session's verdict: from the snapshot its header
+    recorded at the start (``"gauge_checks": {channel: GaugeStatus.as_json()}``), else looked up
+    now in the register for the gauges the header names (``"gauges"``); a warning when it names
+    none. A damaged register is a warning line, never a lost verdict."""
+    recorded = header.get("gauge_checks")
+    if isinstance(recorded, Mapping) and all(
+        isinstance(v, Mapping) and "sentence" in v for v in recorded.values()
+    ):
+        return coverage_lines(recorded)
+    gauges = session_gauges(header)
+    if not gauges:
+        return coverage_lines({})
+    try:
+        return coverage_lines(coverage(gauges, today, path=path, valid_days=valid_days))
+    except StationError as error:
+        return [f"WARNING: the gauge register cannot be read ({error.message})"]

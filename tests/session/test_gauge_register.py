@@ -95,3 +95,36 @@ def test_damaged_register_and_bad_dates_are_sentences(tmp_path: Path):
     with pytest.raises(StationError, match="YYYY-MM-DD"):
         record_check(tmp_path / "new.json", "G-1", GOOD, when=TODAY, calibration_due="next May")
     assert not (tmp_path / "new.json").exists()
+
+
+def test_a_repeatability_sessions_verdict_shows_its_gauge_check(tmp_path: Path):
+    from datetime import UTC, datetime
+
+    from station.session.gauge_register import verdict_lines
+    from station.session.journal import SessionWriter
+    from station.session.model import load_session
+    from tests.session.conftest import session_header_fields
+
+    register = tmp_path / "gauges.json"
+    record_check(register, "G-1", GOOD, when=dt.date(2026, 11, 2))
+    record_check(register, "G-2", BIASED, when=dt.date(2026, 11, 20))
+    header = session_header_fields() | {"gauges": {"x": "G-1", "y": "G-2", "z": "G-3"}}
+    moment = datetime(2026, 11, 23, 12, 0, 0, tzinfo=UTC)
+    with SessionWriter.create(tmp_path / "sessions", header, now=moment) as writer:
+        path = writer.path
+    session = load_session(path)
+    lines = verdict_lines(session.header, TODAY, path=register)
+    assert lines == [
+        "x: gauge G-1: gauge check passed on 2026-11-02",
+        "y: WARNING: gauge G-2: its last gauge check (2026-11-20) failed "
+        f"(Cg {BIASED.cg:.2f}, Cgk {BIASED.cgk:.2f}); the verdict rests on a gauge that is not "
+        "capable",
+        "z: WARNING: gauge G-3: no gauge check on record; run the gauge_check procedure",
+    ]
+    # A snapshot recorded at the start wins over the register's later state.
+    statuses = coverage(header["gauges"], TODAY, path=register)
+    snapshot = {channel: status.as_json() for channel, status in statuses.items()}
+    record_check(register, "G-2", GOOD, when=dt.date(2026, 11, 28))
+    assert verdict_lines(header | {"gauge_checks": snapshot}, TODAY, path=register) == lines
+    assert verdict_lines(header, TODAY, path=register)[1].startswith("y: gauge G-2: gauge check")
+    assert "names no gauges" in verdict_lines(session_header_fields(), TODAY, path=register)[0]
