@@ -121,3 +121,17 @@ def test_bad_input_is_one_sentence(tmp_path: Path, content, args, fragment):
     assert result.returncode == 2
     assert fragment in result.stderr
     assert result.stderr.count("\n") == 1
+
+
+def test_names_from_the_csv_header_are_shown_as_text(tmp_path: Path):
+    path = tmp_path / "gains.csv"
+    rows = [f"{q},{1 + 0.1 * q}" for q in range(5)]
+    path.write_text("q,k\x1b[31mp\u202e\n" + "\n".join(rows) + "\n")
+    header = tmp_path / "out.h"
+    result = station(path, "--no-plot", "--c", header)
+    assert result.returncode == 0, result.stderr
+    assert "\x1b" not in result.stdout and "\u202e" not in result.stdout
+    assert "GAIN k\\x1b[31mp\\u202e: order 1" in result.stdout
+    text = header.read_text()
+    assert text.isascii() and "\x1b" not in text
+    assert "gain_schedule_k_31mp[2]" in text
