@@ -34,8 +34,14 @@ zone of h and v against s), per direction, the path repeatability along the bar
 and the capability of the straightness against --tolerance. --procedure
 relative_accuracy reads columns placement, x, y, z (optionally the teach
 pendant's px, py, pz) and adds the accuracy per placement and across
-placements. A session file is analysed as its procedure declares (its
-`analysis`) unless --procedure says otherwise.
+placements. --procedure gauge_check reads one column of repeated readings of a
+reference and gives the Type-1 study (Cg, Cgk, bias and its t-test, resolution
+against --tolerance) with --reference X_M and --tolerance T; --procedure
+joint_troubleshooting reads joint, x, y, z (and optionally lever: the joint's
+axis to the cube) and names the suspect joint; --procedure gain_schedule reads
+q and one column per gain (see also station gains fit). A session file is
+analysed as its procedure declares (its `analysis`) unless --procedure says
+otherwise.
 
 exit codes:
   0  analysed
