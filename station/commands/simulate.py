@@ -51,11 +51,14 @@ others):
                J with --joint-fault backlash|noise|servo|encoder of
                --fault-size radians; the healthy joints repeat to 5e-6 rad.
                Printed on stderr as "joint J: ..." when the next joint's turn
-               comes, with its lever arm.
+               comes, with its lever arm. A protocol without a zero command is
+               zeroed in software, which reads one set at the taught position
+               before each joint's returns; the simulated arm follows that.
   gauge-bench  the gauge check (Type-1 study): one indicator x in inches over
                a surface plate (zeroing reads the plate), a gauge block of
                --reference size re-seated for every reading, read with the
-               indicator's --bias and --noise (default 0.00003).
+               indicator's --bias and --noise (default 0.00003). A software
+               zero (no zero command) reads the plate once first.
 """
 
 
@@ -209,14 +212,26 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
         bias = per_channel(args.bias, "--bias", ["x"])["x"]
         noise = per_channel(args.noise, "--noise", ["x"])["x"]
         reference = _float(args.reference, "--reference")
+        # A software zero reads one set on the plate; a device zero reads none.
+        plate_readings = 0 if protocol.zero_command(protocol.channels[0]) else 1
         return GaugeBenchModel(
-            reference, bias=bias, noise=noise, gauge=GaugeSpec(resolution, -0.5, 1.0, "in")
+            reference,
+            bias=bias,
+            noise=noise,
+            gauge=GaugeSpec(resolution, -0.5, 1.0, "in"),
+            plate_readings=plate_readings,
         )
     if args.model == "joints":
         from station.instruments.joint_model import JointModel, faulty_arm
 
         cycles = positive_number(args.cycles_per_joint, "--cycles-per-joint", int)
-        options = {"cycles": cycles, "gauge": GaugeSpec(resolution, -0.5, 0.5, "in")}
+        # A software zero reads one set at the taught position before each joint's returns.
+        home_readings = 0 if protocol.zero_command(protocol.channels[0]) else 1
+        options = {
+            "cycles": cycles,
+            "gauge": GaugeSpec(resolution, -0.5, 0.5, "in"),
+            "home_readings": home_readings,
+        }
         try:
             joint = int(args.faulty_joint)
         except ValueError:

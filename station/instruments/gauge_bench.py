@@ -1,7 +1,9 @@
 """A simulated gauge bench for the gauge check (Type-1 study): one indicator over a surface plate,
 a gauge block of known size re-seated under it for every reading.
 
-Zeroing reads the plate (the indicator's zero: 0, whatever it read before); each reading is the
+A device zero sets the indicator's zero on the plate (:meth:`GaugeBenchModel.zero_reference`);
+a software zero reads one set on the plate, so a run zeroed in software wants
+``plate_readings=1``: its first reading is the plate (0 plus noise). Every later reading is the
 block's size ``reference`` plus the indicator's ``bias`` and its repeatability ``noise`` (σ),
 at the indicator's resolution. A gauge with a bias fails Cgk; a noisy one fails Cg.
 """
@@ -30,6 +32,7 @@ class GaugeBenchModel(RobotModel):
         bias: float = 0.0,
         noise: float = 0.00003,
         gauge: GaugeSpec = BENCH_INDICATOR,
+        plate_readings: int = 0,
     ) -> None:
         if noise < 0:
             raise StationError(f"the gauge's noise must not be negative, not {noise}.")
@@ -40,15 +43,19 @@ class GaugeBenchModel(RobotModel):
             )
         self.reference, self.bias, self.noise = float(reference), float(bias), float(noise)
         self._gauge = gauge
+        if plate_readings < 0:
+            raise StationError("the readings on the plate must not be negative.")
+        self.plate_readings = int(plate_readings)
 
     def gauge(self, channel: str) -> GaugeSpec:
         """The indicator."""
         return self._gauge
 
     def value(self, channel: str, k: int, seed: int) -> float:
-        """The k-th reading of the block."""
+        """The k-th reading: the plate for the first ``plate_readings``, then the block."""
         noise = random.Random(f"{seed}/bench/{k}").gauss(0.0, 1.0)
-        return self._gauge.show(self.reference + self.bias + self.noise * noise)
+        size = 0.0 if k < self.plate_readings else self.reference + self.bias
+        return self._gauge.show(size + self.noise * noise)
 
     def zero_reference(self, channel: str, k_next: int, seed: int) -> float:
         """Zeroing on the surface plate: the indicator's zero is the plate."""

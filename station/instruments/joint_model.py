@@ -18,6 +18,11 @@ full lost motion
 between the two approach directions (radians), and ``offset`` a constant angular error of the
 return (an encoder whose zero slipped). Each indicator adds its own reading noise ``gauge_noise``.
 
+Zeroing: a device zero (a protocol with a zero command) sets the indicators' zero at the taught
+position without a reading (:meth:`JointModel.zero_reference`); a software zero reads one set
+there, so a run zeroed in software wants ``home_readings=1``: each joint's block then starts with
+that reading at the taught position (no angular error), followed by its ``cycles`` returns.
+
 Determinism as :mod:`station.instruments.simulator`: the k-th reading depends only on the seed
 and k; the joint's angular error of reading k is drawn once for all three indicators.
 """
@@ -83,6 +88,7 @@ class JointModel(RobotModel):
         forearm: float = 16.0,
         gauge_noise: float = 0.00003,
         gauge: GaugeSpec = INCH_INDICATOR,
+        home_readings: int = 0,
     ) -> None:
         if len(joints) != JOINTS:
             raise StationError(f"the joint model's arm has {JOINTS} joints, not {len(joints)}.")
@@ -92,6 +98,9 @@ class JointModel(RobotModel):
             raise StationError("the arm's pose is three joint angles q1, q2, q3.")
         self.joints = tuple(joints)
         self.cycles = int(cycles)
+        if home_readings < 0:
+            raise StationError("the readings at the taught position must not be negative.")
+        self.home_readings = int(home_readings)
         self.pose = tuple(float(q) for q in pose)
         self.upper, self.forearm = float(upper), float(forearm)
         self.gauge_noise = float(gauge_noise)
@@ -108,21 +117,30 @@ class JointModel(RobotModel):
         """|J_j|: how far the cube moves per radian of each joint (in the gauge's unit)."""
         return tuple(math.sqrt(sum(c * c for c in column)) for column in self.columns)
 
+    @property
+    def readings_per_joint(self) -> int:
+        """Readings of each channel per joint: at the taught position, then the returns."""
+        return self.home_readings + self.cycles
+
     def current_joint(self, k: int) -> int:
-        """The joint (1-based) whose cycles the k-th reading belongs to."""
+        """The joint (1-based) whose block the k-th reading belongs to."""
         if self.joint is not None:
             return self.joint
-        return min(k // self.cycles, JOINTS - 1) + 1
+        return min(k // self.readings_per_joint, JOINTS - 1) + 1
 
     def angular_error(self, k: int, seed: int) -> float:
-        """The moving joint's angular error on its return for reading k (radians)."""
+        """The moving joint's angular error on its return for reading k (radians; 0 for a
+        reading at the taught position before the joint moves)."""
         joint = self.current_joint(k)
         fault = self.joints[joint - 1]
+        cycle = k % self.readings_per_joint - self.home_readings
+        if cycle < 0:
+            return 0.0
         rng = random.Random(f"{seed}/joint/{k}")
         z0, z1 = rng.gauss(0.0, 1.0), rng.gauss(0.0, 1.0)
         overshoot = fault.overshoot * (rng.expovariate(1.0) - 1.0) if fault.overshoot else 0.0
         # Odd cycles leave in +, even cycles in −: the return approaches from alternate sides.
-        direction = 1.0 if (k % self.cycles) % 2 == 0 else -1.0
+        direction = 1.0 if cycle % 2 == 0 else -1.0
         return (
             fault.offset
             + fault.noise * _skew_normal_unit(fault.skew, z0, z1)
@@ -147,11 +165,13 @@ class JointModel(RobotModel):
         return 0.0
 
     def table(self, seed: int = 0) -> list[tuple[int, float, float, float]]:
-        """Rows ``(joint, x, y, z)`` of a whole run (what ``station analyze --procedure
-        joint_troubleshooting`` reads from a CSV)."""
+        """Rows ``(joint, x, y, z)`` of the returns of a whole run (what ``station analyze
+        --procedure joint_troubleshooting`` reads from a CSV; readings at the taught position
+        left out)."""
         return [
             (self.current_joint(k), *(self.value(c, k, seed) for c in self.channels))
-            for k in range(JOINTS * self.cycles)
+            for k in range(JOINTS * self.readings_per_joint)
+            if k % self.readings_per_joint >= self.home_readings
         ]
 
 
