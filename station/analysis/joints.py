@@ -122,6 +122,11 @@ class JointsAnalysis:
     reason: str
 
     @property
+    def angular(self) -> bool:
+        """True when the joints were compared by angular spread (every lever arm known)."""
+        return all(j.angular_spread is not None for j in self.joints)
+
+    @property
     def reading(self) -> str | None:
         """The report's reading of the suspect's pattern, as a sentence."""
         return None if self.cause is None else READINGS[self.cause]
@@ -134,6 +139,7 @@ class JointsAnalysis:
             "cause": self.cause,
             "reading": self.reading,
             "reason": self.reason,
+            "compared": "angular spread" if self.angular else "spread at the fixture",
             "levene_statistic": self.levene_statistic,
             "levene_p": self.levene_p,
             "bartlett_statistic": self.bartlett_statistic,
@@ -145,7 +151,7 @@ class JointsAnalysis:
         columns)."""
         import textwrap
 
-        angular = all(j.angular_spread is not None for j in self.joints)
+        angular = self.angular
         lines = [
             "PER-JOINT TROUBLESHOOTING (each joint moved alone, the others held)",
             f"  ranked by share of the {'angular ' if angular else ''}variance; spread: 3-D σ"
@@ -178,6 +184,13 @@ class JointsAnalysis:
         lines.extend(textwrap.wrap(verdict, **wrap))  # type: ignore[arg-type]
         if self.reading is not None:
             lines.extend(textwrap.wrap(f"Reading: {self.reading}", **wrap))  # type: ignore[arg-type]
+        if not angular:
+            note = (
+                "Note: compared by the spread at the fixture; without the lever arms a joint far "
+                "from the cube (the base) spreads it more for the same angular repeatability. "
+                "Give each joint's lever arm to compare the joints themselves."
+            )
+            lines.extend(textwrap.wrap(note, **wrap))  # type: ignore[arg-type]
         return lines
 
 

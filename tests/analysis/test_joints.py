@@ -73,6 +73,10 @@ def test_without_lever_arms_the_base_spreads_the_cube_most():
     share = {j.joint: j.share for j in plain.joints}
     assert share[1] > 2 * share[3]
     assert {j.joint: j.angular_spread for j in corrected.joints}[3] is not None
+    assert not plain.angular and corrected.angular
+    assert plain.as_json()["compared"] == "spread at the fixture"
+    assert any("Give each joint's lever arm" in line for line in plain.lines())
+    assert not any("Give each joint's lever arm" in line for line in corrected.lines())
 
 
 def test_jacobian_matches_finite_differences():
