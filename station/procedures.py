@@ -14,7 +14,8 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
     channels = ["x", "y", "z"]
     unit = "in"                     # "in" or "mm"
     resolution = 0.0001             # the gauge's resolution in `unit`
-    analysis = "repeatability"      # optional: repeatability, relative_accuracy or linearity;
+    analysis = "repeatability"      # optional: repeatability, relative_accuracy, linearity,
+                                    # gauge_check, joint_troubleshooting or gain_schedule;
                                     # default by the steps: a stroke step -> linearity, a repeat
                                     # block -> relative_accuracy, else repeatability
 
@@ -146,6 +147,12 @@ _ANALYSES: dict[str, AnalysisNeeds] = {
         facet="block", facet_words="a repeat block (one per placement)", channels=("x", "y", "z")
     ),
     "linearity": AnalysisNeeds(facet="direction", facet_words="a stroke step (streamed strokes)"),
+    # The method kinds of issue 15; their own checks are in _check_method_kind.
+    "gauge_check": AnalysisNeeds(facet="counts", facet_words="a cycles step (the readings)"),
+    "joint_troubleshooting": AnalysisNeeds(
+        facet="block", facet_words="a repeat block (one per joint)", channels=("x", "y", "z")
+    ),
+    "gain_schedule": AnalysisNeeds(),
 }
 
 
@@ -554,7 +561,53 @@ def _analysis_kind(
         raise check.fail(
             "", f"'analysis' {declared} needs the channels {', '.join(needs.channels)}"
         )
+    _check_method_kind(check, declared, steps, channels)
     return str(declared)
+
+
+def _number_fields(steps: tuple[Step, ...]) -> set[str]:
+    every = [*steps, *(inner for step in steps for inner in step.steps)]
+    return {
+        f.name for step in every if step.kind == "input" for f in step.fields if f.type == "number"
+    }
+
+
+def _check_method_kind(
+    check: _Checker, declared: str, steps: tuple[Step, ...], channels: tuple[str, ...]
+) -> None:
+    """What the gauge check, per-joint troubleshooting and gain schedule analyses read: the
+    input fields and steps they need (so a site's edit that drops one fails on load)."""
+    every = [*steps, *(inner for step in steps for inner in step.steps)]
+    numbers = _number_fields(steps)
+    if declared == "gauge_check":
+        if not any(step.kind == "cycles" for step in every):
+            raise check.fail(
+                "", "'analysis' gauge_check needs a cycles step (the repeated readings)"
+            )
+        if not {"reference", "tolerance"} <= numbers:
+            raise check.fail(
+                "",
+                "'analysis' gauge_check needs an input step with number fields 'reference' "
+                "and 'tolerance'",
+            )
+    elif declared == "joint_troubleshooting":
+        if not any(
+            step.kind == "repeat" and any(inner.kind == "cycles" for inner in step.steps)
+            for step in steps
+        ):
+            raise check.fail(
+                "",
+                "'analysis' joint_troubleshooting needs a repeat block (one per joint) "
+                "holding a cycles step",
+            )
+        if not {"x", "y", "z"} <= set(channels):
+            raise check.fail("", "'analysis' joint_troubleshooting needs the channels x, y and z")
+    elif declared == "gain_schedule" and ("q" not in numbers or len(numbers) < 2):
+        raise check.fail(
+            "",
+            "'analysis' gain_schedule needs an input step with a number field 'q' (the "
+            "position) and one number field per gain",
+        )
 
 
 def _parse_limits(

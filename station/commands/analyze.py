@@ -34,8 +34,14 @@ zone of h and v against s), per direction, the path repeatability along the bar
 and the capability of the straightness against --tolerance. --procedure
 relative_accuracy reads columns placement, x, y, z (optionally the teach
 pendant's px, py, pz) and adds the accuracy per placement and across
-placements. A session file is analysed as its procedure declares (its
-`analysis`) unless --procedure says otherwise.
+placements. --procedure gauge_check reads one column of repeated readings of a
+reference and gives the Type-1 study (Cg, Cgk, bias and its t-test, resolution
+against --tolerance) with --reference X_M and --tolerance T; --procedure
+joint_troubleshooting reads joint, x, y, z (and optionally lever: the joint's
+axis to the cube) and names the suspect joint; --procedure gain_schedule reads
+q and one column per gain (see also station gains fit). A session file is
+analysed as its procedure declares (its `analysis`) unless --procedure says
+otherwise.
 
 exit codes:
   0  analysed
@@ -97,7 +103,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--tolerance",
         metavar="T",
         help="linearity: straightness tolerance, the zone width per stroke (default: the "
-        "session's, from its h/v limits)",
+        "session's, from its h/v limits); gauge_check: the tolerance T the gauge will judge",
+    )
+    parser.add_argument(
+        "--reference",
+        metavar="X_M",
+        help="gauge_check: the reference's known size (default: the session's, typed in)",
     )
     parser.add_argument("--json", action="store_true", help="print one JSON document")
     parser.add_argument(
@@ -245,6 +256,14 @@ def run(args: argparse.Namespace) -> int:
         threshold=recorded.threshold if threshold is None else threshold,
     )
     procedure = args.procedure or source.analysis or "repeatability"
+    from station.session.method_reports import METHOD_KINDS
+
+    if procedure in METHOD_KINDS:  # gauge check, per-joint troubleshooting, gain schedule
+        from station.commands._methods import run_method
+
+        return run_method(args, source, procedure, path)
+    if args.reference is not None:
+        raise StationError("--reference is the reference size of --procedure gauge_check.")
     tolerance = parse_number(args.tolerance, "--tolerance")
     if tolerance is not None and not tolerance > 0:
         raise StationError(f"--tolerance {args.tolerance!r} must be greater than 0.")

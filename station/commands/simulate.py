@@ -43,6 +43,22 @@ others):
                per second (default 200, as a counter's continuous output does):
                capture with --trigger push. The robot advances one point per
                set sent.
+  joints       per-joint troubleshooting (report 1.2, 2.8): x, y, z in inches
+               at the fixture of a 3-joint arm (base, shoulder, elbow), each
+               joint moved alone for --cycles-per-joint returns in turn (joint
+               1 first, leaving in alternate directions); its angular error
+               reaches the fixture through the arm's Jacobian. --faulty-joint
+               J with --joint-fault backlash|noise|servo|encoder of
+               --fault-size radians; the healthy joints repeat to 5e-6 rad.
+               Printed on stderr as "joint J: ..." when the next joint's turn
+               comes, with its lever arm. A protocol without a zero command is
+               zeroed in software, which reads one set at the taught position
+               before each joint's returns; the simulated arm follows that.
+  gauge-bench  the gauge check (Type-1 study): one indicator x in inches over
+               a surface plate (zeroing reads the plate), a gauge block of
+               --reference size re-seated for every reading, read with the
+               indicator's --bias and --noise (default 0.00003). A software
+               zero (no zero command) reads the plate once first.
 
 --cycle-period S makes the fixture model's robot leave the fixture and come
 back every S seconds, as a playback loop does: at rest (the model's bias,
@@ -78,10 +94,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--link", metavar="PATH", help="pty: also make PATH a symlink to it")
     parser.add_argument(
         "--model",
-        choices=("fixture", "two-fixture", "bar"),
+        choices=("fixture", "two-fixture", "bar", "joints", "gauge-bench"),
         default="fixture",
-        help="the set-up: fixture (repeatability, default), two-fixture (relative accuracy) or "
-        "bar (linearity)",
+        help="the set-up: fixture (repeatability, default), two-fixture (relative accuracy), "
+        "bar (linearity), joints (per-joint troubleshooting) or gauge-bench (gauge check)",
     )
     parser.add_argument("--channels", default="x,y,z", help="station channels (default x,y,z)")
     parser.add_argument("--seed", default="0", help="random seed (default 0)")
@@ -121,6 +137,20 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         ("--period", "5", "period of the wobble along the bar"),
     ):
         bar.add_argument(flag, default=default, metavar="V", help=f"{text} (default {default})")
+    joints = parser.add_argument_group("joints model (per-joint troubleshooting)")
+    joints.add_argument("--faulty-joint", default="0", metavar="J", help="1, 2 or 3 (0 = none)")
+    joints.add_argument(
+        "--joint-fault",
+        default="backlash",
+        choices=("backlash", "noise", "servo", "encoder"),
+        help="the faulty joint's fault (backlash)",
+    )
+    joints.add_argument("--fault-size", default="4e-5", metavar="RAD", help="radians (4e-5)")
+    joints.add_argument(
+        "--cycles-per-joint", default="25", metavar="N", help="returns per joint (25)"
+    )
+    bench = parser.add_argument_group("gauge-bench model (gauge check)")
+    bench.add_argument("--reference", default="0.1", metavar="V", help="gauge block size (0.1)")
     gauge = parser.add_argument_group("gauge")
     gauge.add_argument(
         "--resolution", help="gauge resolution (0.001; two-fixture and bar 0.0001 in)"
@@ -205,6 +235,40 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
     if args.model == "fixture":
         return None
     resolution = positive_number(args.resolution, "--resolution")
+    if args.model == "gauge-bench":
+        from station.instruments.gauge_bench import GaugeBenchModel
+
+        bias = per_channel(args.bias, "--bias", ["x"])["x"]
+        noise = per_channel(args.noise, "--noise", ["x"])["x"]
+        reference = _float(args.reference, "--reference")
+        # A software zero reads one set on the plate; a device zero reads none.
+        plate_readings = 0 if protocol.zero_command(protocol.channels[0]) else 1
+        return GaugeBenchModel(
+            reference,
+            bias=bias,
+            noise=noise,
+            gauge=GaugeSpec(resolution, -0.5, 1.0, "in"),
+            plate_readings=plate_readings,
+        )
+    if args.model == "joints":
+        from station.instruments.joint_model import JointModel, faulty_arm
+
+        cycles = positive_number(args.cycles_per_joint, "--cycles-per-joint", int)
+        # A software zero reads one set at the taught position before each joint's returns.
+        home_readings = 0 if protocol.zero_command(protocol.channels[0]) else 1
+        options = {
+            "cycles": cycles,
+            "gauge": GaugeSpec(resolution, -0.5, 0.5, "in"),
+            "home_readings": home_readings,
+        }
+        try:
+            joint = int(args.faulty_joint)
+        except ValueError:
+            raise StationError(f"--faulty-joint {args.faulty_joint!r} is 1, 2, 3 or 0.") from None
+        if joint == 0:
+            return JointModel(**options)
+        size = _float(args.fault_size, "--fault-size")
+        return faulty_arm(joint, args.joint_fault, size=size, **options)
     if args.model == "two-fixture":
         axes = ["x", "y", "z"]
         scale = per_channel(args.scale, "--scale", axes)
@@ -258,7 +322,13 @@ def build_simulator(args: argparse.Namespace):
     if args.resolution is None:
         args.resolution = "0.001" if args.model == "fixture" else "0.0001"
     if args.noise is None:
-        args.noise = {"fixture": "0.0005", "two-fixture": "0.0002", "bar": "0.00005"}[args.model]
+        args.noise = {
+            "fixture": "0.0005",
+            "two-fixture": "0.0002",
+            "bar": "0.00005",
+            "joints": "0",
+            "gauge-bench": "0.00003",
+        }[args.model]
     channels = [c.strip() for c in args.channels.split(",") if c.strip()]
     if not channels or len(set(channels)) != len(channels):
         raise StationError(f"--channels {args.channels!r}: name each channel once, e.g. x,y,z.")
@@ -358,11 +428,37 @@ def show_pendant(simulator) -> None:
     simulator.on_sent = on_sent
 
 
+def show_joint(simulator) -> None:
+    """Print on stderr which joint to move when its turn comes (joints model), with its lever
+    arm (the distance from its axis to the cube, for the analysis)."""
+    model = simulator.model
+    channels = tuple(simulator.channel_map.values())
+    levers = model.lever_arms()
+    shown = [0]
+
+    def on_sent(channel: str, k: int) -> None:
+        sent = min(len(simulator.sent[c]) for c in channels)
+        number = model.current_joint(sent)
+        if number != shown[0]:
+            shown[0] = number
+            print(
+                f"joint {number}: move only joint {number} away and back (lever arm "
+                f"{levers[number - 1]:.3f} in)",
+                file=sys.stderr,
+                flush=True,
+            )
+
+    on_sent("", 0)
+    simulator.on_sent = on_sent
+
+
 def run(args: argparse.Namespace) -> int:
     """Print the URL, serve until SIGINT/SIGTERM."""
     simulator = build_simulator(args)
     if args.model == "two-fixture":
         show_pendant(simulator)
+    if args.model == "joints":
+        show_joint(simulator)
     done = threading.Event()
     # A hang-up (the SSH session closing) or Ctrl-C stops as cleanly as SIGTERM: the pty, the
     # link and its private folder go away.

@@ -350,6 +350,9 @@ def test_the_analysis_kind_defaults_by_step_kinds(tmp_path: Path) -> None:
         "repeatability": "repeatability",
         "relative_accuracy": "relative_accuracy",
         "linearity": "linearity",
+        "gauge_check": "gauge_check",
+        "joint_troubleshooting": "joint_troubleshooting",
+        "gain_schedule": "gain_schedule",
     }
 
 

@@ -1,0 +1,355 @@
+"""The gauge register: which indicator was checked when, with what result, and when it is due.
+
+A verdict on a robot is only as good as the gauges that measured it. The register is one small
+JSON file in the station's data folder (``$XDG_DATA_HOME/station/gauges.json``, by default
+``~/.local/share/station/gauges.json``; ``STATION_GAUGES`` names another file). Per gauge id or
+serial it keeps the Type-1 checks recorded (newest last, at most :data:`HISTORY` of them) and
+the calibration due date::
+
+    {"format": "station-gauges/1",
+     "gauges": {"MIT-543-0042": {"calibration_due": "2027-05-01",
+                                 "checks": [{"date": "2026-11-29", "result": "passed",
+                                             "cg": 2.1, "cgk": 1.8, "bias": 0.00002,
+                                             "bias_p": 0.31, "reference": 1.0,
+                                             "tolerance": 0.002, "session": "..."}]}}}
+
+A repeatability session names the gauge on each channel; :func:`coverage` looks each up
+(passed, failed, overdue or none) so the session can record which checks covered it and its
+verdict can say "gauge check passed on DATE" or warn. A check is *overdue* when the gauge's
+calibration due date has passed, or when the last check is older than ``valid_days`` (the
+report asks for calibration and testing "every four to six months": 183 days by default).
+
+Writes are whole or nothing: a temporary file (created exclusively, never through a symlink)
+is synced and renamed over the register, under an advisory lock so two stations on one machine
+do not lose each other's check. A register that is a symlink is refused, not followed.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime as dt
+import errno
+import fcntl
+import json
+import os
+import secrets
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+from station.errors import StationError
+from station.session.durable import fsync_folder, make_folders
+
+if TYPE_CHECKING:
+    from station.analysis.gauge_check import GaugeCheck
+
+FORMAT = "station-gauges/1"
+REGISTER_ENV = "STATION_GAUGES"
+#: Checks kept per gauge (the oldest are dropped).
+HISTORY = 50
+#: How long a passed check covers a gauge: the report's "every four to six months".
+VALID_DAYS = 183
+
+State = Literal["passed", "failed", "overdue", "none"]
+
+
+def register_path(environ: Mapping[str, str] | None = None) -> Path:
+    """The register file: ``STATION_GAUGES``, else ``$XDG_DATA_HOME/station/gauges.json``."""
+    environ = os.environ if environ is None else environ
+    if environ.get(REGISTER_ENV):
+        return Path(environ[REGISTER_ENV])
+    data_home = environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share")
+    return Path(data_home) / "station" / "gauges.json"
+
+
+def parse_date(text: str | dt.date, what: str = "date") -> dt.date:
+    """A date written ``YYYY-MM-DD`` (as typed at an input step); StationError otherwise."""
+    if isinstance(text, dt.date):
+        return text
+    try:
+        return dt.date.fromisoformat(str(text).strip())
+    except ValueError:
+        raise StationError(f"the {what} {text!r} is not a date; write it as YYYY-MM-DD.") from None
+
+
+def _refuse_symlink(path: Path) -> None:
+    if path.is_symlink():
+        raise StationError(
+            f"the gauge register {path} is a symbolic link; station does not follow links for "
+            "files it writes: replace it with the file itself."
+        )
+
+
+def load_register(path: Path) -> dict[str, Any]:
+    """The register's content (an empty register when the file does not exist yet)."""
+    _refuse_symlink(path)
+    try:
+        descriptor = os.open(path, os.O_RDONLY | os.O_NOFOLLOW)
+    except FileNotFoundError:
+        return {"format": FORMAT, "gauges": {}}
+    except OSError as error:
+        raise StationError(f"cannot read the gauge register {path}: {error.strerror}.") from None
+    with os.fdopen(descriptor, "rb") as stream:
+        data = stream.read()
+    try:
+        content = json.loads(data.decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError):
+        raise StationError(
+            f"the gauge register {path} is damaged (not JSON); move it aside to start a new one."
+        ) from None
+    if (
+        not isinstance(content, dict)
+        or content.get("format") != FORMAT
+        or not isinstance(content.get("gauges"), dict)
+    ):
+        raise StationError(
+            f"the gauge register {path} is not a {FORMAT} file; move it aside to start a new one."
+        )
+    return content
+
+
+@contextlib.contextmanager
+def _locked(path: Path) -> Iterator[None]:
+    lock_path = path.with_name(f".{path.name}.lock")
+    _refuse_symlink(lock_path)
+    descriptor = os.open(lock_path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o644)
+    try:
+        fcntl.flock(descriptor, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(descriptor)
+
+
+def _write(path: Path, content: Mapping[str, Any]) -> None:
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
+    text = json.dumps(content, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
+    descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644)
+    try:
+        with os.fdopen(descriptor, "w", encoding="utf-8") as stream:
+            stream.write(text)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.replace(temporary, path)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
+    fsync_folder(path.parent)
+
+
+def _gauge_key(gauge: str) -> str:
+    key = str(gauge).strip()
+    if not key or any(not ch.isprintable() for ch in key) or len(key) > 100:
+        raise StationError(
+            f"gauge id {gauge!r} cannot be registered: give the gauge's id or serial number "
+            "(printable, up to 100 characters)."
+        )
+    return key
+
+
+def record_check(
+    path: Path,
+    gauge: str,
+    study: GaugeCheck,
+    *,
+    when: dt.date,
+    calibration_due: dt.date | str | None = None,
+    session: str | None = None,
+) -> dict[str, Any]:
+    """Add a Type-1 study of ``gauge`` done on ``when`` to the register at ``path`` (created
+    with its folder when missing); ``calibration_due`` updates the gauge's due date. Returns
+    the entry recorded. StationError when the register cannot be read or written."""
+    key = _gauge_key(gauge)
+    result = {"capable": "passed", "not capable": "failed"}.get(study.verdict, "no verdict")
+    entry: dict[str, Any] = {
+        "date": when.isoformat(),
+        "result": result,
+        **{k: study.as_json()[k] for k in ("cg", "cgk", "bias", "bias_p", "resolution_ratio")},
+        "reference": study.reference,
+        "tolerance": study.tolerance,
+        "n": study.n,
+    }
+    if session:
+        entry["session"] = session
+    due = None if calibration_due in (None, "") else parse_date(calibration_due, "calibration due")
+    try:
+        make_folders(path.parent)
+        with _locked(path):
+            content = load_register(path)
+            record = content["gauges"].setdefault(key, {"calibration_due": None, "checks": []})
+            if due is not None:
+                record["calibration_due"] = due.isoformat()
+            record["checks"] = [*record.get("checks", []), entry][-HISTORY:]
+            _write(path, content)
+    except OSError as error:
+        reason = error.strerror or str(error)
+        if error.errno == errno.ELOOP:
+            reason = "a symbolic link is in the way"
+        raise StationError(f"cannot write the gauge register {path}: {reason}.") from None
+    return entry
+
+
+@dataclass(frozen=True)
+class GaugeStatus:
+    """What the register says of one gauge on a given day."""
+
+    gauge: str
+    state: State
+    checked: dt.date | None
+    calibration_due: dt.date | None
+    cg: float | None = None
+    cgk: float | None = None
+    reason: str = ""
+
+    @property
+    def covered(self) -> bool:
+        """True when a passed, current check covers the gauge."""
+        return self.state == "passed"
+
+    def sentence(self) -> str:
+        """``gauge check passed on 2026-11-02`` or a warning naming what is wrong."""
+        name = "".join(ch if ch.isprintable() else "?" for ch in self.gauge)
+        if self.state == "passed":
+            due = (
+                f", calibration due {self.calibration_due.isoformat()}"
+                if self.calibration_due
+                else ""
+            )
+            return f"gauge {name}: gauge check passed on {self.checked}{due}"
+        if self.state == "none":
+            return f"WARNING: gauge {name}: no gauge check on record; run the gauge_check procedure"
+        if self.state == "failed":
+            return (
+                f"WARNING: gauge {name}: its last gauge check ({self.checked}) failed"
+                f"{self.reason}; the verdict rests on a gauge that is not capable"
+            )
+        return f"WARNING: gauge {name}: {self.reason}; check it again before trusting the verdict"
+
+    def as_json(self) -> dict[str, Any]:
+        """The status as recorded in a session (a snapshot: the register changes later)."""
+        return {
+            "gauge": self.gauge,
+            "state": self.state,
+            "checked": None if self.checked is None else self.checked.isoformat(),
+            "calibration_due": None
+            if self.calibration_due is None
+            else self.calibration_due.isoformat(),
+            "cg": self.cg,
+            "cgk": self.cgk,
+            "reason": self.reason,
+            "sentence": self.sentence(),
+        }
+
+
+def gauge_status(
+    register: Mapping[str, Any], gauge: str, today: dt.date, *, valid_days: int = VALID_DAYS
+) -> GaugeStatus:
+    """The state of ``gauge`` on ``today`` in a loaded register (:func:`load_register`):
+    ``none`` (never checked), ``failed`` (its last check did not pass), ``overdue`` (its
+    calibration due date has passed, or its last check is older than ``valid_days``) or
+    ``passed``."""
+    record = register.get("gauges", {}).get(str(gauge).strip())
+    if not record or not record.get("checks"):
+        return GaugeStatus(str(gauge), "none", None, None)
+    last = record["checks"][-1]
+    checked = parse_date(last["date"], "check date")
+    due = record.get("calibration_due")
+    due_date = None if not due else parse_date(due, "calibration due date")
+    common = {"cg": last.get("cg"), "cgk": last.get("cgk")}
+    if last.get("result") != "passed":
+        cg, cgk = last.get("cg"), last.get("cgk")
+        detail = (
+            f" (Cg {cg:.2f}, Cgk {cgk:.2f})"
+            if isinstance(cg, int | float) and isinstance(cgk, int | float)
+            else " (no verdict)"
+        )
+        return GaugeStatus(str(gauge), "failed", checked, due_date, reason=detail, **common)
+    if due_date is not None and due_date < today:
+        return GaugeStatus(
+            str(gauge),
+            "overdue",
+            checked,
+            due_date,
+            reason=f"calibration was due on {due_date.isoformat()}",
+            **common,
+        )
+    age = (today - checked).days
+    if age > valid_days:
+        return GaugeStatus(
+            str(gauge),
+            "overdue",
+            checked,
+            due_date,
+            reason=f"its last check ({checked.isoformat()}) is {age} days old (over {valid_days})",
+            **common,
+        )
+    return GaugeStatus(str(gauge), "passed", checked, due_date, **common)
+
+
+def coverage(
+    gauges: Mapping[str, str],
+    today: dt.date,
+    *,
+    path: Path | None = None,
+    valid_days: int = VALID_DAYS,
+) -> dict[str, GaugeStatus]:
+    """Per channel the status of the gauge on it (``{"x": "MIT-0042", ...}``) on ``today``,
+    from the register at ``path`` (default :func:`register_path`). A channel without a gauge id
+    is ``none``."""
+    register = load_register(path or register_path())
+    return {
+        channel: gauge_status(register, gauge, today, valid_days=valid_days)
+        if str(gauge).strip()
+        else GaugeStatus("(not named)", "none", None, None)
+        for channel, gauge in gauges.items()
+    }
+
+
+def coverage_lines(statuses: Mapping[str, GaugeStatus | Mapping[str, Any]]) -> list[str]:
+    """The verdict's lines on the gauges: one per channel, from :func:`coverage` or from the
+    snapshot a session recorded (``GaugeStatus.as_json()``); a line saying there are no gauge
+    ids when the session named none."""
+    if not statuses:
+        return [
+            "WARNING: the session names no gauges, so no gauge check covers it; "
+            "run the gauge_check procedure and name the gauges at set-up"
+        ]
+    lines = []
+    for channel, status in statuses.items():
+        sentence = status.sentence() if isinstance(status, GaugeStatus) else status["sentence"]
+        lines.append(f"{channel}: {sentence}")
+    return lines
+
+
+def session_gauges(header: Mapping[str, Any]) -> dict[str, str]:
+    """The gauge id on each channel as a session header records it (``"gauges": {"x":
+    "MIT-0042", ...}``); empty when the session names none."""
+    recorded = header.get("gauges") or {}
+    if not isinstance(recorded, Mapping):
+        return {}
+    return {str(channel): str(gauge) for channel, gauge in recorded.items()}
+
+
+def verdict_lines(
+    header: Mapping[str, Any],
+    today: dt.date,
+    *,
+    path: Path | None = None,
+    valid_days: int = VALID_DAYS,
+) -> list[str]:
+    """The gauge lines of a repeatability session's verdict: from the snapshot its header
+    recorded at the start (``"gauge_checks": {channel: GaugeStatus.as_json()}``), else looked up
+    now in the register for the gauges the header names (``"gauges"``); a warning when it names
+    none. A damaged register is a warning line, never a lost verdict."""
+    recorded = header.get("gauge_checks")
+    if isinstance(recorded, Mapping) and all(
+        isinstance(v, Mapping) and "sentence" in v for v in recorded.values()
+    ):
+        return coverage_lines(recorded)
+    gauges = session_gauges(header)
+    if not gauges:
+        return coverage_lines({})
+    try:
+        return coverage_lines(coverage(gauges, today, path=path, valid_days=valid_days))
+    except StationError as error:
+        return [f"WARNING: the gauge register cannot be read ({error.message})"]
