@@ -250,6 +250,9 @@ class SessionSetup:
                 "ports": [port.header() for port in self.ports],
             },
             "cycles_target": self.resolved_cycles,
+            # The count below which a verdict is provisional, and when the live limits freeze.
+            "cycles_min": self.procedure.cycles_min,
+            "freeze_after": self.procedure.cycles_min,
             **({"placements_target": self.placements} if self.placements else {}),
             **({"strokes_target": self.strokes} if self.strokes else {}),
             "rules": self.rule_set,
@@ -468,15 +471,21 @@ def analysis_config(header: Mapping[str, Any]) -> Any:
     The live analysis of a running session and the batch analysis of its file are both built
     from this, so the two agree.
     """
+    from station.analysis.phases import DEFAULT_FREEZE_AFTER, baseline_from_json
     from station.analysis.summary import AnalysisConfig
+    from station.analysis.verdict import DEFAULT_MIN_N
 
     resolution = header.get("resolution")
+    minimum, freeze = header.get("cycles_min"), header.get("freeze_after")
     return AnalysisConfig(
         limits=header_limits(header),
         resolution=float(resolution) if isinstance(resolution, int | float) else None,
         unit=str(header.get("unit") or ""),
         rule_set=str(header.get("rules") or "report"),
         threshold=float(header.get("threshold") or 1.0),
+        min_n=minimum if isinstance(minimum, int) and minimum >= 0 else DEFAULT_MIN_N,
+        freeze_after=freeze if isinstance(freeze, int) and freeze >= 2 else DEFAULT_FREEZE_AFTER,
+        baseline=baseline_from_json(header.get("baseline")),
     )
 
 

@@ -174,3 +174,35 @@ def phase_two_alarms(
         points, frozen.center, frozen.point_sigma, rule_set, unit=unit, cycles=cycles
     )
     return tuple(rules) + ewma_alarms(points, frozen, cycles, unit=unit).alarms
+
+
+def baseline_to_json(baseline: ControlBaseline) -> dict[str, object]:
+    """A baseline as the session header records it."""
+    return {
+        "source": baseline.source,
+        "limits": {
+            channel: {"center": f.center, "ucl": f.ucl, "lcl": f.lcl}
+            for channel, f in baseline.limits.items()
+        },
+    }
+
+
+def baseline_from_json(value: object) -> ControlBaseline | None:
+    """The baseline a session header records (None when it records none). A damaged entry is
+    a StationError naming the channel."""
+    if not isinstance(value, Mapping):
+        return None
+    source = str(value.get("source") or "baseline")
+    limits: dict[str, FrozenLimits] = {}
+    for channel, spec in (value.get("limits") or {}).items():
+        try:
+            limits[str(channel)] = FrozenLimits(
+                float(spec["center"]), float(spec["ucl"]), float(spec["lcl"]), source
+            )
+        except (KeyError, TypeError, ValueError):
+            from station.errors import StationError
+
+            raise StationError(
+                f"the baseline of channel {channel!r} needs numbers center, ucl and lcl."
+            ) from None
+    return ControlBaseline(limits, source)

@@ -50,6 +50,8 @@ class SessionSource:
     notes: tuple[str, ...]
     analysis: str
     """The analysis kind the session's procedure declares (:func:`session_analysis`)."""
+    times: dict[str, np.ndarray] | None = None
+    """The time (s) of each reading, for the drift's trend test."""
 
 
 @dataclass(frozen=True)
@@ -69,6 +71,12 @@ class SessionReport:
     title: str
     notes: tuple[str, ...] = ()
     excluded_cycles: tuple[int, ...] = ()
+    recorded_alarms: tuple[Any, ...] | None = None
+    """A session's alarm events with their acknowledgements (``station.session.alarms``);
+    None for a CSV table."""
+    alarm_lines: tuple[str, ...] = ()
+    """The report block of those alarms and their causes (empty for a CSV table): print it
+    after ``sections``."""
 
     @property
     def lines(self) -> tuple[str, ...]:
@@ -101,6 +109,10 @@ class SessionReport:
 
             document["accuracy"] = accuracy_json(self.result)
         document["procedure"] = self.kind
+        if self.recorded_alarms is not None:
+            from station.session.alarms import recorded_alarms_json
+
+            document["recorded_alarms"] = recorded_alarms_json(self.recorded_alarms)
         return document
 
 
@@ -135,6 +147,7 @@ def session_source(session: Session) -> SessionSource:
         config=analysis_config(session.header),
         notes=tuple(notes),
         analysis=session_analysis(session),
+        times={name: times for name, times in session.channel_times().items() if name in channels},
     )
 
 
@@ -244,6 +257,7 @@ def judge(
     tolerance: float | None = None,
     width: int = 80,
     notes: Sequence[str] = (),
+    times: Mapping[str, Any] | None = None,
 ) -> SessionReport:
     """Analyse readings as ``kind`` says: repeatability (``channels``), linearity (the strokes
     ``profiles()`` gives, straightness against ``tolerance``, by default the one the limits of h
@@ -282,7 +296,13 @@ def judge(
         result = None
         sections = ()
         analysis = (
-            analyze(dict(channels), config, excluded_cycles=excluded_cycles, cycles=cycles)
+            analyze(
+                dict(channels),
+                config,
+                excluded_cycles=excluded_cycles,
+                cycles=cycles,
+                times=times,
+            )
             if channels
             else None
         )
@@ -308,8 +328,12 @@ def report_session(
     """The analysis and report of a loaded session: as its procedure declares unless ``kind``
     says otherwise, with the settings it recorded unless ``config`` replaces them. Raises
     StationError when a linearity or relative-accuracy session has nothing to analyse yet."""
+    from dataclasses import replace as replaced
+
+    from station.session.alarms import format_recorded_alarms, recorded_alarms
+
     session = source.session
-    return judge(
+    report = judge(
         kind or source.analysis,
         source.config if config is None else config,
         name=Path(session.path).name,
@@ -321,6 +345,13 @@ def report_session(
         tolerance=tolerance,
         width=width,
         notes=source.notes,
+        times=source.times,
+    )
+    alarms = recorded_alarms(session)
+    return replaced(
+        report,
+        recorded_alarms=alarms,
+        alarm_lines=tuple(format_recorded_alarms(alarms, width)),
     )
 
 
@@ -348,9 +379,11 @@ def analyze_session(session: Session) -> Analysis | None:
     channels, cycles = accepted_readings(session)
     if not channels:
         return None
+    times = session.channel_times()
     return analyze(
         channels,
         analysis_config(session.header),
         excluded_cycles=session.excluded_cycles,
         cycles=cycles,
+        times={name: times[name] for name in channels},
     )
