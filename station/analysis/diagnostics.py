@@ -257,7 +257,7 @@ class Autocorrelation:
 MIN_AUTOCORRELATION_N = 8
 
 AUTOCORRELATION_EXPLANATION = (
-    "successive readings are correlated (lag-1 r = {r1:+.2f}, p = {p}): the moving ranges "
+    "successive readings are correlated (lag-1 r = {r1:+.2f}, {p}): the moving ranges "
     "understate the spread, so the I-MR limits are too tight and alarms may be false; compare "
     "the within-sigma and overall-sigma indices, and judge by the overall ones"
 )
@@ -299,10 +299,10 @@ def autocorrelation(
         ratio = float(np.std(array, ddof=1)) / sigma_within
     message = None
     if p < alpha and r1 > 0:
-        message = AUTOCORRELATION_EXPLANATION.format(r1=r1, p=p_text(p))
+        message = AUTOCORRELATION_EXPLANATION.format(r1=r1, p=p_phrase(p))
     elif p < alpha:
         message = (
-            f"successive readings alternate (lag-1 r = {r1:+.2f}, p = {p_text(p)}): the moving "
+            f"successive readings alternate (lag-1 r = {r1:+.2f}, {p_phrase(p)}): the moving "
             "ranges overstate the spread; look for over-correction or two causes taking turns"
         )
     return Autocorrelation(r1, z, p, alpha, p < alpha, n, ratio, message)
@@ -313,6 +313,12 @@ def p_text(p: float) -> str:
     if p < 0.001:
         return "< 0.001"
     return f"{p:.3f}" if p < 0.01 else f"{p:.2f}"
+
+
+def p_phrase(p: float) -> str:
+    """``p = 0.003`` or ``p < 0.001``."""
+    text = p_text(p)
+    return f"p {text}" if text.startswith("<") else f"p = {text}"
 
 
 @dataclass(frozen=True)
@@ -475,7 +481,7 @@ def drift(
     if found.significant and found.per_span is not None and found.p_value is not None:
         message = (
             f"{subject}drifts {found.per_span:+.2g}{' ' + unit if unit else ''} per "
-            f"{found.span} cycles, p = {p_text(found.p_value)}: let the robot warm up and repeat"
+            f"{found.span} cycles, {p_phrase(found.p_value)}: let the robot warm up and repeat"
         )
     elif chart is not None and chart.signals:
         message = (

@@ -186,7 +186,7 @@ def _capability_lines(
 def format_diagnostics(channel: ChannelAnalysis, decimals: int, width: int = 80) -> list[str]:
     """Normality (and the percentile indices when it is rejected), lag-1 autocorrelation with
     the within- and overall-sigma indices side by side, and drift (trend and EWMA)."""
-    from station.analysis.diagnostics import p_text
+    from station.analysis.diagnostics import p_phrase
 
     lines: list[str] = []
     normal = channel.normality
@@ -197,7 +197,7 @@ def format_diagnostics(channel: ChannelAnalysis, decimals: int, width: int = 80)
             outcome = "rejected" if normal.rejected else "not rejected"
             lines += _wrap(
                 f"NORMALITY ({normal.test}): statistic {normal.statistic:.4f}, "
-                f"p = {p_text(normal.p_value or 0.0)}: normality {outcome} at "
+                f"{p_phrase(normal.p_value or 0.0)}: normality {outcome} at "
                 f"{normal.alpha:g}",
                 width,
             )
@@ -229,7 +229,7 @@ def format_diagnostics(channel: ChannelAnalysis, decimals: int, width: int = 80)
             lines += _wrap(f"AUTOCORRELATION lag 1: not tested ({auto.message})", width)
         else:
             lines += _wrap(
-                f"AUTOCORRELATION lag 1: r = {auto.r1:+.2f}, p = {p_text(auto.p_value or 0.0)}"
+                f"AUTOCORRELATION lag 1: r = {auto.r1:+.2f}, {p_phrase(auto.p_value or 0.0)}"
                 f" ({'significant' if auto.significant else 'not significant'} at "
                 f"{auto.alpha:g})",
                 width,
@@ -253,7 +253,7 @@ def format_diagnostics(channel: ChannelAnalysis, decimals: int, width: int = 80)
             lines += _wrap(
                 f"DRIFT: trend on {basis} {signed(trend.per_span, decimals)} per "
                 f"{trend.span} cycles (95% CI {signed(trend.low, decimals)} to "
-                f"{signed(trend.high, decimals)}), p = {p_text(trend.p_value or 0.0)}",
+                f"{signed(trend.high, decimals)}), {p_phrase(trend.p_value or 0.0)}",
                 width,
             )
         if found.ewma is not None:

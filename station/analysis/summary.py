@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -132,8 +133,6 @@ class ChannelAnalysis:
     """The verdict word (PROVISIONAL below ``config.min_n``) and its line."""
     out_of_spec: OutOfSpec | None = None
     normality: Normality | None = None
-    percentile: PercentileCapability | None = None
-    """ISO 22514-2 percentile indices, computed when normality is rejected (limits given)."""
     autocorrelation: Autocorrelation | None = None
     drift: Drift | None = None
     frozen: FrozenLimits | None = None
@@ -141,6 +140,15 @@ class ChannelAnalysis:
     live_alarms: tuple[Alarm, ...] = ()
     """The alarms against the frozen limits: those the live analysis raised."""
     times: tuple[float, ...] = ()
+
+    @cached_property
+    def percentile(self) -> PercentileCapability | None:
+        """ISO 22514-2 percentile indices when normality is rejected and limits are given
+        (None otherwise). Computed on first use: the distribution fit costs ~20 ms, too much
+        for every redraw of a live snapshot that does not show it."""
+        if self.normality is None or not self.normality.rejected or self.limits is None:
+            return None
+        return percentile_capability(self.readings, self.limits, self.capability.threshold)
 
     @property
     def capability_method(self) -> str:
@@ -341,19 +349,21 @@ def analyze_channel(
             sigma_within=chart.sigma_within,
         )
     normal = normality(values, config.resolution)
-    percentile = None
-    if normal.rejected and limits is not None:
-        percentile = percentile_capability(values, limits, config.threshold)
     frozen = frozen_limits_of(name, values, config)
     live: tuple[Alarm, ...] = ()
-    if frozen is not None and chart.points:
-        live = phase_two_alarms(
-            chart.points,
-            frozen,
-            config.rule_set,
-            point_cycles(labels, chart.subgroup, len(chart.points)),
-            unit=config.unit or None,
-        )
+    if frozen is not None:
+        # The plotted points as the live analysis has them (a chart of one reading has none).
+        size = config.subgroup
+        complete = len(values) // size
+        points = values[: complete * size].reshape(complete, size).mean(axis=1)
+        if complete:
+            live = phase_two_alarms(
+                points.tolist() if size > 1 else values.tolist(),
+                frozen,
+                config.rule_set,
+                point_cycles(labels, size, complete),
+                unit=config.unit or None,
+            )
     clock = None if times is None or len(times) != len(values) else tuple(float(t) for t in times)
     return ChannelAnalysis(
         name=name,
@@ -369,7 +379,6 @@ def analyze_channel(
         verdict=judge_verdict(cap, config.min_n),
         out_of_spec=out_of_spec(values, limits, labels),
         normality=normal,
-        percentile=percentile,
         autocorrelation=autocorrelation(values, sigma_within=chart.sigma_within),
         drift=drift(
             values, chart.sigma_within, times=clock, cycles=labels, name=name, unit=config.unit
