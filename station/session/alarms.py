@@ -68,6 +68,24 @@ class RecordedAlarm:
         return bool(self.acks)
 
 
+@dataclass(frozen=True)
+class AckRequest:
+    """What an operator asked for in the alarm list: acknowledge alarm event ``alarm`` (its
+    seq) with ``cause``, ``text`` and the corrective ``action``. The engine turns it into an
+    ``ack`` event with :meth:`fields`."""
+
+    alarm: int
+    cause: str
+    text: str = ""
+    action: str = ""
+
+    def fields(self, causes: Sequence[str] = DEFAULT_CAUSES, by: str = "") -> dict[str, Any]:
+        """The checked fields of the ``ack`` event (see :func:`ack_fields`)."""
+        return ack_fields(
+            self.alarm, self.cause, causes=causes, text=self.text, action=self.action, by=by
+        )
+
+
 def ack_fields(
     alarm_seq: int,
     cause: str,
