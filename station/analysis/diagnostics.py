@@ -74,7 +74,7 @@ class OutOfSpec:
 def out_of_spec(
     values: Iterable[float] | np.ndarray,
     limits: SpecLimits | None,
-    cycles: Sequence[int] | None = None,
+    cycles: Sequence[int] | np.ndarray | None = None,
 ) -> OutOfSpec:
     """The readings below the LSL and above the USL (strictly), named by ``cycles`` (1, 2, 3 ...
     when None). Without limits nothing is out of specification."""
@@ -114,6 +114,9 @@ def _anderson_darling_p(a2: float, n: int) -> float:
     """D'Agostino & Stephens (1986) p-value of the adjusted A*² for a normal with estimated
     mean and sigma (table 4.9)."""
     adjusted = a2 * (1 + 0.75 / n + 2.25 / n**2)
+    if adjusted >= 153.0:
+        # The fitted curve's minimum (≈ 1e-265); beyond it the quadratic turns up again.
+        return 0.0
     if adjusted >= 0.6:
         p = math.exp(1.2937 - 5.709 * adjusted + 0.0186 * adjusted**2)
     elif adjusted >= 0.34:
@@ -268,10 +271,12 @@ def lag1(array: np.ndarray) -> float | None:
     import numpy as np
 
     deviations = array - array.mean()
-    denominator = float(np.dot(deviations, deviations))
+    # Products summed by numpy rather than np.dot: BLAS threads on a shared, loaded machine
+    # made the dot product 30x slower here.
+    denominator = float(np.sum(deviations * deviations))
     if not denominator > 0:
         return None
-    return float(np.dot(deviations[:-1], deviations[1:]) / denominator)
+    return float(np.sum(deviations[:-1] * deviations[1:]) / denominator)
 
 
 def autocorrelation(
@@ -323,16 +328,15 @@ def p_phrase(p: float) -> str:
 
 @dataclass(frozen=True)
 class Ewma:
-    """An EWMA chart: the statistic and its limits per point, the centre and sigma it used, and
-    the 1-based points (``signals``) beyond a limit, with their cycles."""
+    """An EWMA chart's verdict: the centre and sigma it used, its last value, and the 1-based
+    points (``signals``) beyond a limit, with their cycles. (The statistic per point is
+    :func:`ewma_values`; its limits :func:`ewma_limit_half_width`: a chart plots them.)"""
 
     lam: float
     width: float
     center: float
     sigma: float
-    z: tuple[float, ...]
-    ucl: tuple[float, ...]
-    lcl: tuple[float, ...]
+    last: float | None
     signals: tuple[int, ...]
     signal_cycles: tuple[int, ...]
 
@@ -364,7 +368,7 @@ def ewma_chart(
     *,
     lam: float = EWMA_LAMBDA,
     width: float = EWMA_WIDTH,
-    cycles: Sequence[int] | None = None,
+    cycles: Sequence[int] | np.ndarray | None = None,
 ) -> Ewma:
     """The EWMA of the readings about ``center`` with limits from ``sigma`` (the within sigma)."""
     if not 0 < lam <= 1:
@@ -378,15 +382,12 @@ def ewma_chart(
     half = width * sigma * np.sqrt(lam / (2 - lam) * (1 - (1 - lam) ** (2 * index)))
     beyond = np.abs(z - center) > half if sigma > 0 else np.zeros(array.size, bool)
     signals = (np.flatnonzero(beyond) + 1).tolist()
-    z_values, upper, lower = z.tolist(), (center + half).tolist(), (center - half).tolist()
     return Ewma(
         lam=lam,
         width=width,
         center=float(center),
         sigma=float(sigma),
-        z=tuple(z_values),
-        ucl=tuple(upper),
-        lcl=tuple(lower),
+        last=float(z[-1]) if z.size else None,
         signals=tuple(signals),
         signal_cycles=tuple(int(c) for c in labels[beyond]),
     )
@@ -464,7 +465,7 @@ def drift(
     sigma_within: float | None,
     *,
     times: Sequence[float] | None = None,
-    cycles: Sequence[int] | None = None,
+    cycles: Sequence[int] | np.ndarray | None = None,
     name: str = "",
     unit: str = "",
 ) -> Drift:

@@ -137,9 +137,30 @@ class ChannelAnalysis:
     drift: Drift | None = None
     frozen: FrozenLimits | None = None
     """The phase II limits the live alarms are judged against (None: too few points yet)."""
-    live_alarms: tuple[Alarm, ...] = ()
-    """The alarms against the frozen limits: those the live analysis raised."""
+    phase_rules: tuple[str, str, int] = ("report", "", 1)
+    """Rule set, unit and subgroup size the live alarms are judged with."""
     times: tuple[float, ...] = ()
+
+    @cached_property
+    def live_alarms(self) -> tuple[Alarm, ...]:
+        """The alarms against the frozen limits: those the live analysis raised. Computed on
+        first use: against limits frozen early a long drifting record raises very many."""
+        if self.frozen is None:
+            return ()
+        rule_set, unit, size = self.phase_rules
+        values = np.asarray(self.readings, dtype=float)
+        complete = len(values) // size
+        if not complete:
+            return ()
+        # The plotted points as the live analysis has them (a chart of one reading has none).
+        points = values if size == 1 else values[: complete * size].reshape(complete, size).mean(1)
+        return phase_two_alarms(
+            points.tolist(),
+            self.frozen,
+            rule_set,
+            point_cycles(self.cycles, size, complete),
+            unit=unit or None,
+        )
 
     @cached_property
     def percentile(self) -> PercentileCapability | None:
@@ -349,21 +370,8 @@ def analyze_channel(
             sigma_within=chart.sigma_within,
         )
     normal = normality(values, config.resolution)
+    label_array = np.asarray(labels, dtype=int)
     frozen = frozen_limits_of(name, values, config)
-    live: tuple[Alarm, ...] = ()
-    if frozen is not None:
-        # The plotted points as the live analysis has them (a chart of one reading has none).
-        size = config.subgroup
-        complete = len(values) // size
-        points = values[: complete * size].reshape(complete, size).mean(axis=1)
-        if complete:
-            live = phase_two_alarms(
-                points.tolist() if size > 1 else values.tolist(),
-                frozen,
-                config.rule_set,
-                point_cycles(labels, size, complete),
-                unit=config.unit or None,
-            )
     clock = None if times is None or len(times) != len(values) else tuple(float(t) for t in times)
     return ChannelAnalysis(
         name=name,
@@ -377,14 +385,19 @@ def analyze_channel(
         nominal=config.nominal_for(name),
         cycles=labels,
         verdict=judge_verdict(cap, config.min_n),
-        out_of_spec=out_of_spec(values, limits, labels),
+        out_of_spec=out_of_spec(values, limits, label_array),
         normality=normal,
         autocorrelation=autocorrelation(values, sigma_within=chart.sigma_within),
         drift=drift(
-            values, chart.sigma_within, times=clock, cycles=labels, name=name, unit=config.unit
+            values,
+            chart.sigma_within,
+            times=clock,
+            cycles=label_array,
+            name=name,
+            unit=config.unit,
         ),
         frozen=frozen,
-        live_alarms=live,
+        phase_rules=(config.rule_set, config.unit, config.subgroup),
         times=clock or (),
     )
 

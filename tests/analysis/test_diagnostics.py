@@ -165,6 +165,10 @@ def test_large_samples_use_anderson_darling():
     assert result.test == "Anderson-Darling" and not result.rejected
     skewed = np.random.default_rng(2).exponential(1, 6000)
     assert normality(skewed).rejected
+    # Far from normal (A² in the thousands): p is 0, not an overflow.
+    two_steps = np.repeat([0.0, 0.0001], 50_000)
+    result = normality(two_steps)
+    assert result.rejected and result.p_value == 0.0
 
 
 def test_a_coarse_gauge_step_is_noted():
