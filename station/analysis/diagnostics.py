@@ -320,6 +320,14 @@ def p_text(p: float) -> str:
     return f"{p:.3f}" if p < 0.01 else f"{p:.2f}"
 
 
+def two_digits(value: float) -> str:
+    """A signed figure to two significant digits in plain decimals: +0.000082, -0.0013."""
+    if value == 0 or not math.isfinite(value):
+        return f"{value:+g}"
+    places = max(0, 1 - math.floor(math.log10(abs(value))))
+    return f"{value:+.{places}f}"
+
+
 def p_phrase(p: float) -> str:
     """``p = 0.003`` or ``p < 0.001``."""
     text = p_text(p)
@@ -481,7 +489,7 @@ def drift(
     subject = f"{name} " if name else ""
     if found.significant and found.per_span is not None and found.p_value is not None:
         message = (
-            f"{subject}drifts {found.per_span:+.2g}{' ' + unit if unit else ''} per "
+            f"{subject}drifts {two_digits(found.per_span)}{' ' + unit if unit else ''} per "
             f"{found.span} cycles, {p_phrase(found.p_value)}: let the robot warm up and repeat"
         )
     elif chart is not None and chart.signals:
