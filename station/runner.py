@@ -313,6 +313,8 @@ class CycleRecord:
     """The reason when the cycle was rejected afterwards."""
     resolution: float | None = None
     """The session's gauge resolution: :meth:`line` shows that many decimals."""
+    times: Mapping[str, float] | None = None
+    """Each channel's reading time (``t_wall``), for the drift's trend; None when unknown."""
 
     def line(self) -> str:
         """The one-line form ``cycle 7 x=+0.0012 y=-0.0003 z=+0.0001`` (values at the
@@ -462,6 +464,15 @@ def header_limits(header: Mapping[str, Any]) -> dict[str, Any]:
         and isinstance(spec, Mapping)
         and (spec.get("lsl") is not None or spec.get("usl") is not None)
     }
+
+
+def _reading_times(readings: Mapping[str, Any]) -> dict[str, float] | None:
+    """Each channel's ``t_wall`` (the drift's trend runs on reading times), or None when a
+    reading has none (the trend then runs on cycle order, as the session file's analysis)."""
+    times = {channel: getattr(r, "t_wall", None) for channel, r in readings.items()}
+    if any(t is None for t in times.values()):
+        return None
+    return {channel: float(t) for channel, t in times.items()}
 
 
 def analysis_config(header: Mapping[str, Any]) -> Any:
@@ -751,6 +762,7 @@ class Runner:
                         placement=cycle.placement,
                         rejected=session.rejected.get(number),
                         resolution=self.setup.resolved_resolution,
+                        times=_reading_times(cycle.readings),
                     )
                 )
             self._next_cycle = session.next_cycle
@@ -1490,7 +1502,7 @@ class Runner:
         self._live = self._new_live()
         for record in self._cycles:
             if record.rejected is None:
-                self._live.add_set(record.values, record.cycle)
+                self._live.add_set(record.values, record.cycle, record.times)
 
     def _current_item(self) -> _PlanItem:
         self._ensure_open()
@@ -1655,6 +1667,7 @@ class Runner:
             step_id=item.step.id,
             placement=item.placement,
             resolution=self.setup.resolved_resolution,
+            times=_reading_times(readings),
         )
         self._cycles.append(record)
         self._accepted_by_step[item.key] = self._accepted_by_step.get(item.key, 0) + 1
@@ -1662,7 +1675,7 @@ class Runner:
         # Acknowledged: the listener hears of the reading as soon as it is on disk, with the
         # state that includes it; the live figures and alarms follow.
         self._notify(self._last_event)
-        self._record_alarms(self._live.add_set(record.values, number))
+        self._record_alarms(self._live.add_set(record.values, number, record.times))
         if item.step.kind == "capture":
             self._complete_step(item, by)
         elif item.step.kind == "cycles":

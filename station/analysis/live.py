@@ -123,6 +123,7 @@ class ReadingSet:
 
     cycle: int
     values: Mapping[str, float]
+    times: Mapping[str, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -163,11 +164,15 @@ class LiveMonitor:
         )
 
     def add_set(
-        self, values: Mapping[str, float], cycle: int
+        self,
+        values: Mapping[str, float],
+        cycle: int,
+        times: Mapping[str, float] | None = None,
     ) -> tuple[dict[str, LiveUpdate], list[LiveAlarm]]:
-        """Add one recorded cycle; the updates per channel and the alarms that are new."""
-        self._accepted.append(ReadingSet(cycle, dict(values)))
-        updates = self.live.add_set(values, cycle)
+        """Add one recorded cycle (with its readings' times, when known); the updates per
+        channel and the alarms that are new."""
+        self._accepted.append(ReadingSet(cycle, dict(values), times))
+        updates = self.live.add_set(values, cycle, times)
         new = [
             LiveAlarm(channel, cycle, alarm)
             for channel, update in updates.items()
@@ -193,7 +198,7 @@ class LiveMonitor:
             self.config, self.channel_names, freeze_after=self.freeze_after, baseline=baseline
         )
         for reading_set in self._accepted:
-            self.live.add_set(reading_set.values, reading_set.cycle)
+            self.live.add_set(reading_set.values, reading_set.cycle, reading_set.times)
 
     def frozen_limits(self) -> dict[str, FrozenLimits]:
         """The phase II limits of each channel that has them."""
@@ -220,7 +225,7 @@ def replay_live_alarms(
         if isinstance(event, Rejection):
             monitor.reject(event.cycle)
         else:
-            raised.extend(monitor.add_set(event.values, event.cycle)[1])
+            raised.extend(monitor.add_set(event.values, event.cycle, event.times)[1])
     return raised
 
 
@@ -296,6 +301,7 @@ class LiveChannel:
         self._ewma_side = 0
         self._values: list[float] = []
         self._cycles: list[int] = []
+        self._times: list[float | None] = []
         # Moments of the readings minus the first one: readings far from 0 (an indicator not
         # zeroed) would otherwise lose digits in the running mean.
         self._origin = 0.0
@@ -335,9 +341,10 @@ class LiveChannel:
         """A copy of the readings' cycle numbers, in the order they were added."""
         return list(self._cycles)
 
-    def add(self, value: float, cycle: int | None = None) -> LiveUpdate:
+    def add(self, value: float, cycle: int | None = None, t: float | None = None) -> LiveUpdate:
         """Add one reading (a finite number) of cycle number ``cycle`` (default: its position,
-        1, 2, 3 ...) and return the updated figures."""
+        1, 2, 3 ...), read at time ``t`` (seconds; the drift's trend runs on reading times when
+        every reading has one), and return the updated figures."""
         x = float(value)
         if not math.isfinite(x):
             from station.errors import StationError
@@ -348,6 +355,7 @@ class LiveChannel:
         previous = self._values[-1] if self._values else None
         self._values.append(x)
         self._cycles.append(len(self._values) if cycle is None else int(cycle))
+        self._times.append(None if t is None else float(t))
         self._snapshot = None
         n = len(self._values)
 
@@ -616,7 +624,14 @@ class LiveChannel:
                 from station.errors import StationError
 
                 raise StationError(f"channel {self.name!r} has no readings yet.")
-            self._snapshot = analyze_channel(self.name, self._values, self.config, self._cycles)
+            times = None if None in self._times else self._times
+            self._snapshot = analyze_channel(
+                self.name,
+                self._values,
+                self.config,
+                self._cycles,
+                times,  # type: ignore[arg-type]
+            )
         return self._snapshot
 
 
@@ -648,17 +663,25 @@ class LiveAnalysis:
             )
         return self.channels[name]
 
-    def add(self, name: str, value: float, cycle: int | None = None) -> LiveUpdate:
-        """Add one reading of channel ``name`` (of cycle number ``cycle``, see
+    def add(
+        self, name: str, value: float, cycle: int | None = None, t: float | None = None
+    ) -> LiveUpdate:
+        """Add one reading of channel ``name`` (of cycle number ``cycle``, read at ``t``, see
         :meth:`LiveChannel.add`)."""
-        return self.channel(name).add(value, cycle)
+        return self.channel(name).add(value, cycle, t)
 
     def add_set(
-        self, readings: Mapping[str, float], cycle: int | None = None
+        self,
+        readings: Mapping[str, float],
+        cycle: int | None = None,
+        times: Mapping[str, float] | None = None,
     ) -> dict[str, LiveUpdate]:
         """Add one cycle's reading set (channel → value); ``cycle`` is its number, so alarms
-        name cycles (default: each channel's reading count)."""
-        return {name: self.add(name, value, cycle) for name, value in readings.items()}
+        name cycles (default: each channel's reading count); ``times`` the readings' times."""
+        stamps = times or {}
+        return {
+            name: self.add(name, value, cycle, stamps.get(name)) for name, value in readings.items()
+        }
 
     def snapshot(self) -> Analysis:
         """The whole analysis so far (channels with readings): equal to the batch ``analyze``."""

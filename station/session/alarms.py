@@ -164,7 +164,9 @@ def live_events(session: Session) -> list[ReadingSet | Rejection]:
         if event["type"] == "reading":
             cycle = session.cycles[event["cycle"]]
             values = {channel: r.value for channel, r in cycle.readings.items()}
-            events.append(ReadingSet(cycle.number, values))
+            times = {channel: r.t_wall for channel, r in cycle.readings.items()}
+            known = None if None in times.values() else times
+            events.append(ReadingSet(cycle.number, values, known))  # type: ignore[arg-type]
         elif event["type"] == "reject":
             events.append(Rejection(int(event["cycle"])))
     return events
