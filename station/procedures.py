@@ -36,6 +36,11 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
     nominal = 0.0                   # optional, default 0
     # ... or per channel:  x = { lsl = -0.001, usl = 0.001, nominal = 0.0 }  or  x = [-0.001, 0.001]
 
+    causes = ["fixture moved", "gauge", "temperature", "robot", "other"]
+                                    # optional: the assignable causes an operator acknowledges
+                                    # an alarm with (this list is the default; "other" asks for
+                                    # a text and is always offered)
+
     [[steps]]
     id = "fixture"
     kind = "check"                  # check input zero capture cycles stroke repeat
@@ -180,6 +185,10 @@ def analysis_kinds() -> tuple[str, ...]:
 
 
 DEFAULT_CYCLES_MIN = 25
+#: The assignable causes an alarm is acknowledged with when the procedure names none.
+DEFAULT_CAUSES: tuple[str, ...] = ("fixture moved", "gauge", "temperature", "robot", "other")
+#: The cause that asks the operator to say what it was.
+OTHER_CAUSE = "other"
 DEFAULT_CYCLES_TARGET = 30
 PROCEDURES_ENV = "STATION_PROCEDURES"
 
@@ -267,6 +276,8 @@ class Procedure:
     """How its sessions are analysed: the file's ``analysis``, else by its steps."""
     arrival: ArrivalConfig = field(default_factory=ArrivalConfig)
     """The ``arrival`` trigger's parameters: the file's ``[arrival]``, else the defaults."""
+    causes: tuple[str, ...] = DEFAULT_CAUSES
+    """The assignable causes an alarm is acknowledged with; "other" (with a text) is last."""
 
     def all_steps(self) -> Iterator[Step]:
         """Every step in file order, including those inside repeat blocks (after their block)."""
@@ -433,6 +444,7 @@ _TOP_KEYS = (
     "analysis",
     "cycles",
     "limits",
+    "causes",
     "steps",
     "arrival",
 )
@@ -499,6 +511,7 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
         _parse_step(context, raw, str(index)) for index, raw in enumerate(raw_steps, start=1)
     )
     analysis = _analysis_kind(check, table.get("analysis"), steps, channels)
+    causes = _parse_causes(check, table.get("causes"))
     return Procedure(
         id=procedure_id,
         title=title,
@@ -516,7 +529,27 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
         sha256=hashlib.sha256(data).hexdigest(),
         analysis=analysis,
         arrival=arrival,
+        causes=causes,
     )
+
+
+def _parse_causes(check: _Checker, value: Any) -> tuple[str, ...]:
+    """The file's ``causes``: distinct, non-empty, one line each; "other" is added at the end
+    when missing, so an operator can always name a cause the list did not foresee."""
+    if value is None:
+        return DEFAULT_CAUSES
+    if not isinstance(value, list) or not value:
+        raise check.fail("", '\'causes\' must be a list of short texts, e.g. ["gauge", "other"]')
+    causes: list[str] = []
+    for item in value:
+        if not isinstance(item, str) or not item.strip() or "\n" in item or len(item) > 60:
+            raise check.fail("", f"'causes' holds {item!r}: give one line of text (60 at most)")
+        if item.strip() in causes:
+            raise check.fail("", f"'causes' names {item.strip()!r} twice")
+        causes.append(item.strip())
+    if OTHER_CAUSE not in causes:
+        causes.append(OTHER_CAUSE)
+    return tuple(causes)
 
 
 def _parse_arrival(check: _Checker, table: Mapping[str, Any] | None) -> ArrivalConfig:

@@ -14,7 +14,7 @@ placement, §2.8).
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -36,6 +36,7 @@ from station.analysis.report import format_accuracy, format_linearity
 from station.analysis.summary import Analysis, AnalysisConfig, analyze, to_json
 from station.errors import StationError
 from station.procedures import AnalysisNeeds, discover_procedures, register_analysis_needs
+from station.session.alarms import format_recorded_alarms, recorded_alarms, recorded_alarms_json
 from station.session.header import analysis_config
 from station.session.model import Session, load_session
 
@@ -61,6 +62,8 @@ class KindInputs:
     width: int = 80
     options: Mapping[str, Any] = None  # type: ignore[assignment]
     """Kind-specific values (a reference size, a tolerance) from the command line or header."""
+    times: Mapping[str, Any] | None = None
+    """The time (s) of each reading per channel, for the drift's trend test."""
 
 
 @dataclass(frozen=True)
@@ -76,8 +79,11 @@ class Judgement:
 class LiveVerdict(Protocol):
     """A kind's live analysis, fed by the engine as events reach the disk."""
 
-    def add_cycle(self, values: Mapping[str, float], cycle: int) -> Mapping[str, Any]:
-        """Take one accepted cycle; per channel an update whose ``alarms`` are new."""
+    def add_cycle(
+        self, values: Mapping[str, float], cycle: int, times: Mapping[str, float] | None = None
+    ) -> Mapping[str, Any]:
+        """Take one accepted cycle (``times``: each reading's time); per channel an update
+        whose ``alarms`` are new."""
         ...
 
     def add_stroke(self, outcome: Any) -> None:
@@ -96,9 +102,7 @@ class LiveVerdict(Protocol):
         """Every alarm of the full analysis so far, as (channel, alarm), oldest first."""
         ...
 
-    def rebuilt(
-        self, cycles: Sequence[tuple[Mapping[str, float], int]], session: Session | None
-    ) -> LiveVerdict:
+    def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveVerdict:
         """A fresh live analysis of ``cycles`` keeping what is not a cycle (strokes), or
         taking that from ``session`` when given (resume)."""
         ...
@@ -162,6 +166,12 @@ class SessionReport:
     title: str
     notes: tuple[str, ...] = ()
     excluded_cycles: tuple[int, ...] = ()
+    recorded_alarms: tuple[Any, ...] | None = None
+    """A session's alarm events with their acknowledgements (``station.session.alarms``);
+    None for a CSV table."""
+    alarm_lines: tuple[str, ...] = ()
+    """The report block of those alarms and their causes (empty for a CSV table): print it
+    after ``sections``."""
 
     @property
     def lines(self) -> tuple[str, ...]:
@@ -185,6 +195,8 @@ class SessionReport:
         if kind.json is not None and kind.json_key and self.result is not None:
             document[kind.json_key] = kind.json(self.result)
         document["procedure"] = self.kind
+        if self.recorded_alarms is not None:
+            document["recorded_alarms"] = recorded_alarms_json(self.recorded_alarms)
         return document
 
 
@@ -220,6 +232,8 @@ class SessionSource:
     notes: tuple[str, ...]
     analysis: str
     """The analysis kind the session's procedure declares (:func:`session_analysis`)."""
+    times: dict[str, np.ndarray] | None = None
+    """The time (s) of each reading, for the drift's trend test."""
 
 
 def accepted_readings(session: Session) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
@@ -249,6 +263,7 @@ def session_source(session: Session) -> SessionSource:
         config=analysis_config(session.header),
         notes=tuple(notes),
         analysis=session_analysis(session),
+        times={name: times for name, times in session.channel_times().items() if name in channels},
     )
 
 
@@ -394,6 +409,7 @@ def session_inputs(
         tolerance=tolerance,
         width=width,
         options=dict(options or {}),
+        times=source.times,
     )
 
 
@@ -412,8 +428,12 @@ def report_session(
     inputs = session_inputs(
         source, config=config, tolerance=tolerance, width=width, options=options
     )
-    return judge(
+    report = judge(
         kind or source.analysis, inputs, name=Path(source.session.path).name, notes=source.notes
+    )
+    alarms = recorded_alarms(source.session)
+    return replace(
+        report, recorded_alarms=alarms, alarm_lines=tuple(format_recorded_alarms(alarms, width))
     )
 
 
@@ -451,8 +471,10 @@ class LiveCycles:
         self.config, self.channels, self.header = config, tuple(channels), header
         self._live = LiveAnalysis(config, self.channels)
 
-    def add_cycle(self, values: Mapping[str, float], cycle: int) -> Mapping[str, Any]:
-        return self._live.add_set(values, cycle)
+    def add_cycle(
+        self, values: Mapping[str, float], cycle: int, times: Mapping[str, float] | None = None
+    ) -> Mapping[str, Any]:
+        return self._live.add_set(values, cycle, times)
 
     def add_stroke(self, outcome: Any) -> None:
         return None
@@ -470,12 +492,10 @@ class LiveCycles:
             for alarm in sorted(result.alarms, key=lambda a: (max(a.points), a.rule))
         ]
 
-    def rebuilt(
-        self, cycles: Sequence[tuple[Mapping[str, float], int]], session: Session | None
-    ) -> LiveCycles:
+    def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveCycles:
         fresh = type(self)(self.config, self.channels, self.header)
-        for values, number in cycles:
-            fresh.add_cycle(values, number)
+        for values, number, *times in cycles:
+            fresh.add_cycle(values, number, times[0] if times else None)
         return fresh
 
 
@@ -499,7 +519,9 @@ class LiveStrokes:
         self.profiles: list[StrokeProfile] = []
         self._result: Any = None
 
-    def add_cycle(self, values: Mapping[str, float], cycle: int) -> Mapping[str, Any]:
+    def add_cycle(
+        self, values: Mapping[str, float], cycle: int, times: Mapping[str, float] | None = None
+    ) -> Mapping[str, Any]:
         return {}
 
     def add_stroke(self, outcome: Any) -> None:
@@ -544,9 +566,7 @@ class LiveStrokes:
     def all_alarms(self) -> list[tuple[str, Any]]:
         return []
 
-    def rebuilt(
-        self, cycles: Sequence[tuple[Mapping[str, float], int]], session: Session | None
-    ) -> LiveStrokes:
+    def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveStrokes:
         fresh = type(self)(self.config, self.channels, self.header)
         if session is None:
             fresh.profiles = list(self.profiles)
@@ -565,6 +585,7 @@ def _repeatability(inputs: KindInputs) -> Judgement:
             inputs.config,
             excluded_cycles=inputs.excluded_cycles,
             cycles=inputs.cycles,
+            times=inputs.times,
         )
         if inputs.channels
         else None
@@ -641,9 +662,11 @@ def analyze_session(session: Session) -> Analysis | None:
     channels, cycles = accepted_readings(session)
     if not channels:
         return None
+    times = session.channel_times()
     return analyze(
         channels,
         analysis_config(session.header),
         excluded_cycles=session.excluded_cycles,
         cycles=cycles,
+        times={name: times[name] for name in channels},
     )

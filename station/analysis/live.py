@@ -48,24 +48,185 @@ records "Cycle 7 is above ..." for the 6th accepted reading without translating 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, replace
 
 from station.analysis.capability import SpecLimits, capability_indices, cpk_lower_bound
 from station.analysis.charts import LARGEST_RANGE_SUBGROUP, chart_type
 from station.analysis.constants import SIGMA_MULTIPLE, chart_factors
 from station.analysis.descriptive import step_multiple
-from station.analysis.rules import Alarm, check_rules
+from station.analysis.diagnostics import EWMA_LAMBDA, EWMA_WIDTH, ewma_limit_half_width
+from station.analysis.phases import (
+    DEFAULT_FREEZE_AFTER,
+    ControlBaseline,
+    FrozenLimits,
+    ewma_alarm,
+    ewma_alarms,
+)
+from station.analysis.rules import Alarm, check_rules, rule_name
 from station.analysis.summary import (
     Analysis,
     AnalysisConfig,
     ChannelAnalysis,
+    PointCycles,
     combine,
     point_cycles,
 )
 
 #: The longest window any rule looks back over (15 points: report rule 3, Nelson 7).
 RULE_WINDOW = 15
+
+
+@dataclass(frozen=True)
+class LiveAlarm:
+    """An alarm the live analysis raised: its channel, the cycle whose reading raised it, and
+    the alarm (rule, points, cycles, sentence)."""
+
+    channel: str
+    cycle: int
+    alarm: Alarm
+
+    def event_fields(self) -> dict[str, object]:
+        """The fields of the journal's ``alarm`` event for it (``live`` marks a phase II alarm;
+        ``rule_name`` says the rule in words)."""
+        return {
+            "channel": self.channel,
+            "rule": self.alarm.rule,
+            "rule_name": rule_name(self.alarm.rule),
+            "points": list(self.alarm.points),
+            "cycles": list(self.alarm.cycles),
+            "text": self.alarm.text,
+            "raised_at": self.cycle,
+            "live": True,
+        }
+
+
+class AlarmLedger:
+    """Which alarms were already raised: an alarm is new unless an alarm of the same channel
+    and rule already flagged one of its cycles (a run growing by a point is one alarm)."""
+
+    def __init__(self) -> None:
+        self._flagged: dict[tuple[str, str], set[int]] = {}
+
+    def admit(self, channel: str, alarm: Alarm) -> bool:
+        """Record the alarm's cycles; True when it is new."""
+        cycles = set(alarm.cycles or ())
+        flagged = self._flagged.setdefault((channel, alarm.rule), set())
+        known = not flagged.isdisjoint(cycles)
+        flagged.update(cycles)
+        return not known
+
+
+@dataclass(frozen=True)
+class ReadingSet:
+    """One accepted cycle's readings (channel → value), as the journal recorded them."""
+
+    cycle: int
+    values: Mapping[str, float]
+    times: Mapping[str, float] | None = None
+
+
+@dataclass(frozen=True)
+class Rejection:
+    """The operator rejected cycle ``cycle`` (its readings leave the analysis)."""
+
+    cycle: int
+
+
+class LiveMonitor:
+    """The live alarms of a running session: a :class:`LiveAnalysis` with phase II limits and
+    an :class:`AlarmLedger`. The engine calls :meth:`add_set` for every recorded cycle and
+    journals the alarms it returns; :func:`replay_live_alarms` runs the same steps over a
+    recorded session, so a replay gives exactly the recorded live alarms.
+
+    A rejected cycle (:meth:`reject`) leaves the analysis; limits already frozen stay frozen
+    (phase II limits never move) and alarms already raised stay raised.
+    """
+
+    def __init__(
+        self,
+        config: AnalysisConfig,
+        channels: Sequence[str] = (),
+        *,
+        freeze_after: int | None = DEFAULT_FREEZE_AFTER,
+        baseline: ControlBaseline | None = None,
+    ) -> None:
+        if freeze_after is None and baseline is None:
+            raise ValueError("a live monitor needs a freeze count or a baseline")
+        self.config = config
+        self.channel_names = tuple(channels)
+        self.freeze_after = freeze_after
+        self.baseline = baseline
+        self.ledger = AlarmLedger()
+        self._accepted: list[ReadingSet] = []
+        self.live = LiveAnalysis(
+            config, self.channel_names, freeze_after=freeze_after, baseline=baseline
+        )
+
+    def add_set(
+        self,
+        values: Mapping[str, float],
+        cycle: int,
+        times: Mapping[str, float] | None = None,
+    ) -> tuple[dict[str, LiveUpdate], list[LiveAlarm]]:
+        """Add one recorded cycle (with its readings' times, when known); the updates per
+        channel and the alarms that are new."""
+        self._accepted.append(ReadingSet(cycle, dict(values), times))
+        updates = self.live.add_set(values, cycle, times)
+        new = [
+            LiveAlarm(channel, cycle, alarm)
+            for channel, update in updates.items()
+            for alarm in update.alarms
+            if self.ledger.admit(channel, alarm)
+        ]
+        return updates, new
+
+    def reject(self, cycle: int) -> None:
+        """Take cycle ``cycle`` out: the analysis is rebuilt from the other cycles, with the
+        limits already frozen kept as they were."""
+        self._accepted = [s for s in self._accepted if s.cycle != cycle]
+        frozen = {
+            name: channel.frozen
+            for name, channel in self.live.channels.items()
+            if channel.frozen is not None
+        }
+        baseline = ControlBaseline(
+            {**({} if self.baseline is None else dict(self.baseline.limits)), **frozen},
+            "" if self.baseline is None else self.baseline.source,
+        )
+        self.live = LiveAnalysis(
+            self.config, self.channel_names, freeze_after=self.freeze_after, baseline=baseline
+        )
+        for reading_set in self._accepted:
+            self.live.add_set(reading_set.values, reading_set.cycle, reading_set.times)
+
+    def frozen_limits(self) -> dict[str, FrozenLimits]:
+        """The phase II limits of each channel that has them."""
+        return {
+            name: channel.frozen
+            for name, channel in self.live.channels.items()
+            if channel.frozen is not None
+        }
+
+
+def replay_live_alarms(
+    events: Iterable[ReadingSet | Rejection],
+    config: AnalysisConfig,
+    channels: Sequence[str] = (),
+    *,
+    freeze_after: int | None = DEFAULT_FREEZE_AFTER,
+    baseline: ControlBaseline | None = None,
+) -> list[LiveAlarm]:
+    """The live alarms a session raised, from its recorded cycles and rejections in journal
+    order: what :class:`LiveMonitor` gave the engine, in the same order."""
+    monitor = LiveMonitor(config, channels, freeze_after=freeze_after, baseline=baseline)
+    raised: list[LiveAlarm] = []
+    for event in events:
+        if isinstance(event, Rejection):
+            monitor.reject(event.cycle)
+        else:
+            raised.extend(monitor.add_set(event.values, event.cycle, event.times)[1])
+    return raised
 
 
 @dataclass(frozen=True)
@@ -102,6 +263,14 @@ class LiveUpdate:
     above_usl: int
     below_lsl: int
     alarms: tuple[Alarm, ...]
+    phase: str = "I"
+    """"I" while the control limits are being estimated, "II" once they are frozen."""
+    frozen: FrozenLimits | None = None
+    """The frozen (phase II) limits the alarms are judged against; None in phase I."""
+    ewma: float | None = None
+    """The EWMA of the chart points about the frozen centre (phase II only)."""
+    out_of_spec: str | None = None
+    """"above" or "below" when this reading is beyond a specification limit, else None."""
 
 
 class LiveChannel:
@@ -111,12 +280,28 @@ class LiveChannel:
     the resolution, subgroup, rule set, threshold and confidence.
     """
 
-    def __init__(self, name: str, config: AnalysisConfig) -> None:
+    def __init__(
+        self,
+        name: str,
+        config: AnalysisConfig,
+        *,
+        freeze_after: int | None = None,
+        baseline: FrozenLimits | None = None,
+    ) -> None:
         self.name = name
         self.config = config
         self.limits: SpecLimits | None = config.limits_for(name)
+        if freeze_after is not None and freeze_after < 2:
+            raise ValueError("control limits need at least 2 chart points before they freeze")
+        self.freeze_after = freeze_after
+        # Phase II: the limits the alarms are judged against, once known; they never move.
+        self._frozen: FrozenLimits | None = baseline
+        self._ewma: float | None = None
+        self._ewma_run_start: int | None = None
+        self._ewma_side = 0
         self._values: list[float] = []
         self._cycles: list[int] = []
+        self._times: list[float | None] = []
         # Moments of the readings minus the first one: readings far from 0 (an indicator not
         # zeroed) would otherwise lose digits in the running mean.
         self._origin = 0.0
@@ -156,9 +341,10 @@ class LiveChannel:
         """A copy of the readings' cycle numbers, in the order they were added."""
         return list(self._cycles)
 
-    def add(self, value: float, cycle: int | None = None) -> LiveUpdate:
+    def add(self, value: float, cycle: int | None = None, t: float | None = None) -> LiveUpdate:
         """Add one reading (a finite number) of cycle number ``cycle`` (default: its position,
-        1, 2, 3 ...) and return the updated figures."""
+        1, 2, 3 ...), read at time ``t`` (seconds; the drift's trend runs on reading times when
+        every reading has one), and return the updated figures."""
         x = float(value)
         if not math.isfinite(x):
             from station.errors import StationError
@@ -169,6 +355,7 @@ class LiveChannel:
         previous = self._values[-1] if self._values else None
         self._values.append(x)
         self._cycles.append(len(self._values) if cycle is None else int(cycle))
+        self._times.append(None if t is None else float(t))
         self._snapshot = None
         n = len(self._values)
 
@@ -183,11 +370,14 @@ class LiveChannel:
         self._m2 += term
         self._min = min(self._min, x)
         self._max = max(self._max, x)
+        side = None
         if self.limits is not None:
             if self.limits.usl is not None and x > self.limits.usl:
                 self._above += 1
+                side = "above"
             if self.limits.lsl is not None and x < self.limits.lsl:
                 self._below += 1
+                side = "below"
         self._count_mode(x)
 
         new_point = False
@@ -203,7 +393,21 @@ class LiveChannel:
             if len(self._open_group) == self._subgroup:
                 self._close_group()
                 new_point = True
-        return self._update(x, new_point)
+        update = self._update(x, new_point)
+        if self.freeze_after is None and self._frozen is None:
+            # Phase I only (no freeze asked for): limits move with every reading.
+            return replace(update, out_of_spec=side)
+        alarms: tuple[Alarm, ...] = ()
+        if new_point:
+            alarms = self._phase_two_alarms(update)
+        return replace(
+            update,
+            alarms=alarms,
+            phase="I" if self._frozen is None else "II",
+            frozen=self._frozen,
+            ewma=self._ewma,
+            out_of_spec=side,
+        )
 
     def _count_mode(self, x: float) -> None:
         step = self.config.resolution
@@ -319,6 +523,98 @@ class LiveChannel:
         )
         return tuple(alarm for alarm in alarms if newest in alarm.points)
 
+    @property
+    def frozen(self) -> FrozenLimits | None:
+        """The phase II limits (from the baseline, or frozen after ``freeze_after`` points)."""
+        return self._frozen
+
+    def _phase_two_alarms(self, update: LiveUpdate) -> tuple[Alarm, ...]:
+        """The alarms a new chart point raises against the frozen limits. At the moment the
+        limits freeze, every earlier point is judged against them too (those alarms are raised
+        then): the live alarms are then exactly the rules over all points against the frozen
+        limits, which is what :func:`phase_two_alarms` computes in one pass."""
+        if self._frozen is None:
+            assert self.freeze_after is not None
+            if len(self._points) < self.freeze_after:
+                return ()
+            if update.center is None or update.ucl is None or not update.ucl > update.center:
+                return ()  # no spread yet: wait for limits that can judge anything
+            self._frozen = FrozenLimits(
+                center=update.center,
+                ucl=update.ucl,
+                lcl=update.lcl if update.lcl is not None else update.center,
+                source=f"first {len(self._points)} points",
+            )
+            return self._catch_up()
+        return self._newest_frozen_alarms()
+
+    def _point_labels(self, first: int) -> PointCycles:
+        """Cycles behind the chart points from number ``first`` (1-based) on."""
+        count = len(self._points) - first + 1
+        return point_cycles(self._cycles[(first - 1) * self._subgroup :], self._subgroup, count)
+
+    def _catch_up(self) -> tuple[Alarm, ...]:
+        frozen = self._frozen
+        assert frozen is not None
+        alarms = check_rules(
+            self._points,
+            frozen.center,
+            frozen.point_sigma,
+            self.config.rule_set,
+            unit=self.config.unit or None,
+            cycles=self._point_labels(1),
+        )
+        ewma = ewma_alarms(
+            self._points, frozen, self._point_labels(1), unit=self.config.unit or None
+        )
+        # Carry the EWMA state on from the last point.
+        self._ewma, self._ewma_run_start = ewma.state, ewma.run_start
+        self._ewma_side = ewma.side
+        return tuple(alarms) + ewma.alarms
+
+    def _newest_frozen_alarms(self) -> tuple[Alarm, ...]:
+        frozen = self._frozen
+        assert frozen is not None
+        tail = self._points[-RULE_WINDOW:]
+        newest = len(self._points)
+        first = newest - len(tail) + 1
+        alarms = check_rules(
+            tail,
+            frozen.center,
+            frozen.point_sigma,
+            self.config.rule_set,
+            unit=self.config.unit or None,
+            first_point=first,
+            cycles=self._point_labels(first),
+        )
+        found = [alarm for alarm in alarms if newest in alarm.points]
+        # The EWMA, one step on.
+        previous = frozen.center if self._ewma is None else self._ewma
+        self._ewma = EWMA_LAMBDA * self._points[-1] + (1 - EWMA_LAMBDA) * previous
+        half = ewma_limit_half_width(frozen.point_sigma, newest, EWMA_LAMBDA, EWMA_WIDTH)
+        if abs(self._ewma - frozen.center) > half:
+            side = 1 if self._ewma > frozen.center else -1
+            if self._ewma_run_start is not None and side != self._ewma_side:
+                self._ewma_run_start = None
+            self._ewma_side = side
+            if self._ewma_run_start is None:
+                self._ewma_run_start = newest
+            run = list(range(self._ewma_run_start, newest + 1))
+            labels = self._point_labels(self._ewma_run_start)
+            found.append(
+                ewma_alarm(
+                    run,
+                    [labels[p - run[0]] for p in run],
+                    self._ewma,
+                    half,
+                    frozen,
+                    self.config.unit or None,
+                )
+            )
+        else:
+            self._ewma_run_start = None
+        return tuple(found)
+
     def snapshot(self) -> ChannelAnalysis:
         """The full analysis of the readings so far: equal to the batch analysis (cached)."""
         if self._snapshot is None:
@@ -328,36 +624,64 @@ class LiveChannel:
                 from station.errors import StationError
 
                 raise StationError(f"channel {self.name!r} has no readings yet.")
-            self._snapshot = analyze_channel(self.name, self._values, self.config, self._cycles)
+            times = None if None in self._times else self._times
+            self._snapshot = analyze_channel(
+                self.name,
+                self._values,
+                self.config,
+                self._cycles,
+                times,  # type: ignore[arg-type]
+            )
         return self._snapshot
 
 
 class LiveAnalysis:
     """Live analysis of several channels sharing one configuration (see :class:`LiveChannel`)."""
 
-    def __init__(self, config: AnalysisConfig, channels: list[str] | tuple[str, ...] = ()) -> None:
+    def __init__(
+        self,
+        config: AnalysisConfig,
+        channels: list[str] | tuple[str, ...] = (),
+        *,
+        freeze_after: int | None = None,
+        baseline: ControlBaseline | None = None,
+    ) -> None:
         self.config = config
+        self.freeze_after = freeze_after
+        self.baseline = baseline
         self.channels: dict[str, LiveChannel] = {}
         for name in channels:
             self.channel(name)
 
     def channel(self, name: str) -> LiveChannel:
-        """The live channel ``name``, created on first use."""
+        """The live channel ``name``, created on first use (with the baseline's limits for it,
+        else freezing after ``freeze_after`` points, else with moving limits)."""
         if name not in self.channels:
-            self.channels[name] = LiveChannel(name, self.config)
+            fixed = None if self.baseline is None else self.baseline.limits.get(name)
+            self.channels[name] = LiveChannel(
+                name, self.config, freeze_after=self.freeze_after, baseline=fixed
+            )
         return self.channels[name]
 
-    def add(self, name: str, value: float, cycle: int | None = None) -> LiveUpdate:
-        """Add one reading of channel ``name`` (of cycle number ``cycle``, see
+    def add(
+        self, name: str, value: float, cycle: int | None = None, t: float | None = None
+    ) -> LiveUpdate:
+        """Add one reading of channel ``name`` (of cycle number ``cycle``, read at ``t``, see
         :meth:`LiveChannel.add`)."""
-        return self.channel(name).add(value, cycle)
+        return self.channel(name).add(value, cycle, t)
 
     def add_set(
-        self, readings: Mapping[str, float], cycle: int | None = None
+        self,
+        readings: Mapping[str, float],
+        cycle: int | None = None,
+        times: Mapping[str, float] | None = None,
     ) -> dict[str, LiveUpdate]:
         """Add one cycle's reading set (channel → value); ``cycle`` is its number, so alarms
-        name cycles (default: each channel's reading count)."""
-        return {name: self.add(name, value, cycle) for name, value in readings.items()}
+        name cycles (default: each channel's reading count); ``times`` the readings' times."""
+        stamps = times or {}
+        return {
+            name: self.add(name, value, cycle, stamps.get(name)) for name, value in readings.items()
+        }
 
     def snapshot(self) -> Analysis:
         """The whole analysis so far (channels with readings): equal to the batch ``analyze``."""

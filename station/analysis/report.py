@@ -20,8 +20,10 @@ from typing import TYPE_CHECKING
 
 from station.analysis.capability import Capability, SpecLimits
 from station.analysis.descriptive import Histogram
+from station.analysis.rules import number_list, rule_name
 from station.analysis.spatial import Spatial
 from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis
+from station.analysis.verdict import Verdict, judge_verdict
 
 if TYPE_CHECKING:
     from station.analysis.accuracy import AccuracyAnalysis
@@ -54,7 +56,10 @@ def index(value: float | None) -> str:
 
 
 def verdict_word(capability: Capability) -> str:
-    """CAPABLE, NOT CAPABLE or UNDEFINED: the verdict is always a word, never only a colour."""
+    """CAPABLE, NOT CAPABLE or UNDEFINED: the verdict is always a word, never only a colour.
+
+    It ignores the minimum count: :func:`station.analysis.verdict.judge_verdict` gives the word
+    with PROVISIONAL below it (what the reports print)."""
     if capability.capable is None:
         return "UNDEFINED"
     return "CAPABLE" if capability.capable else "NOT CAPABLE"
@@ -153,27 +158,117 @@ def format_histogram(
 WITHIN_SIGMA_SOURCE = {"I-MR": "MR-bar/d2", "Xbar-R": "R-bar/d2", "Xbar-S": "S-bar/c4"}
 
 
-def _capability_lines(cap: Capability, chart_type: str, decimals: int, width: int) -> list[str]:
+def _capability_lines(
+    cap: Capability,
+    chart_type: str,
+    decimals: int,
+    width: int,
+    verdict: Verdict | None = None,
+) -> list[str]:
     within_source = WITHIN_SIGMA_SOURCE.get(chart_type, "within subgroups")
     lines = [
         f"CAPABILITY (overall sigma {unsigned(cap.sigma, decimals)}, report §2.7.3)",
         f"  Cp {index(cap.cp)}   Cpu {index(cap.cpu)}   Cpl {index(cap.cpl)}   "
-        f"Cpk {index(cap.cpk)}",
+        f"Cpk {index(cap.cpk) if verdict is None or verdict.cpk is None else verdict.cpk_text}",
         f"  Cpk lower 95% confidence bound (Bissell): {index(cap.cpk_lower)}",
         f"  Within sigma {unsigned(cap.sigma_within, decimals)} ({within_source}):",
         f"    Cp within {index(cap.cp_within)}   Cpk within {index(cap.cpk_within)}",
     ]
     lines = [wrapped for line in lines for wrapped in _wrap(line, width)]
-    word = verdict_word(cap)
-    if cap.capable is None:
-        reason = cap.message or "no verdict"
-        verdict = f"VERDICT: {word} ({reason})"
-    else:
-        relation = ">=" if cap.capable else "<"
-        verdict = f"VERDICT: {word} (Cpk {index(cap.cpk)} {relation} {cap.threshold:g})"
-        if cap.message:
-            verdict += f"; {cap.message}"
-    lines.extend(_wrap(verdict, width))
+    judged = verdict if verdict is not None else judge_verdict(cap, 0)
+    line = f"VERDICT: {judged.text}"
+    if cap.capable is not None and cap.message:
+        line += f"; {cap.message}"
+    lines.extend(_wrap(line, width))
+    return lines
+
+
+def format_diagnostics(channel: ChannelAnalysis, decimals: int, width: int = 80) -> list[str]:
+    """Normality (and the percentile indices when it is rejected), lag-1 autocorrelation with
+    the within- and overall-sigma indices side by side, and drift (trend and EWMA)."""
+    from station.analysis.diagnostics import p_phrase
+
+    lines: list[str] = []
+    normal = channel.normality
+    if normal is not None:
+        if normal.rejected is None:
+            lines += _wrap(f"NORMALITY ({normal.test}): not tested ({normal.message})", width)
+        else:
+            outcome = "rejected" if normal.rejected else "not rejected"
+            lines += _wrap(
+                f"NORMALITY ({normal.test}): statistic {normal.statistic:.4f}, "
+                f"{p_phrase(normal.p_value or 0.0)}: normality {outcome} at "
+                f"{normal.alpha:g}",
+                width,
+            )
+            if normal.ties:
+                lines += _wrap(f"  Note: {normal.ties}", width)
+    percentile = channel.percentile
+    if percentile is not None:
+        lines += _wrap(
+            f"  The data are not normal: Cpk from sigma may mislead. {percentile.method}, "
+            f"quantiles 0.135% {signed(percentile.q_low, decimals)}, median "
+            f"{signed(percentile.median, decimals)}, "
+            f"99.865% {signed(percentile.q_high, decimals)}:",
+            width,
+        )
+        word = (
+            "undefined"
+            if percentile.capable is None
+            else ("capable" if percentile.capable else "not capable")
+        )
+        lines += _wrap(
+            f"    Pp (percentile) {index(percentile.pp)}   Ppu {index(percentile.ppu)}   "
+            f"Ppl {index(percentile.ppl)}   Ppk (percentile) {index(percentile.ppk)}: {word} "
+            f"at {percentile.threshold:g}",
+            width,
+        )
+    auto = channel.autocorrelation
+    if auto is not None:
+        if auto.significant is None:
+            lines += _wrap(f"AUTOCORRELATION lag 1: not tested ({auto.message})", width)
+        else:
+            lines += _wrap(
+                f"AUTOCORRELATION lag 1: r = {auto.r1:+.2f}, {p_phrase(auto.p_value or 0.0)}"
+                f" ({'significant' if auto.significant else 'not significant'} at "
+                f"{auto.alpha:g})",
+                width,
+            )
+            if auto.significant and auto.message:
+                cap = channel.capability
+                lines += _wrap(f"  {auto.message}.", width)
+                lines += _wrap(
+                    f"  Side by side: Cpk (overall sigma {unsigned(cap.sigma, decimals)}) "
+                    f"{index(cap.cpk)}   Cpk within (sigma "
+                    f"{unsigned(cap.sigma_within, decimals)}) {index(cap.cpk_within)}",
+                    width,
+                )
+    found = channel.drift
+    if found is not None:
+        trend = found.trend
+        if trend.per_span is None:
+            lines += _wrap("DRIFT: no trend test (too few readings or no spread)", width)
+        else:
+            basis = "reading times" if trend.basis == "time" else "cycle order"
+            lines += _wrap(
+                f"DRIFT: trend on {basis} {signed(trend.per_span, decimals)} per "
+                f"{trend.span} cycles (95% CI {signed(trend.low, decimals)} to "
+                f"{signed(trend.high, decimals)}), {p_phrase(trend.p_value or 0.0)}",
+                width,
+            )
+        if found.ewma is not None:
+            signals = found.ewma.signal_cycles
+            lines += _wrap(
+                f"  EWMA (lambda {found.ewma.lam:g}, {found.ewma.width:g} sigma within): "
+                + (
+                    f"beyond its limits at cycles {number_list(signals)}"
+                    if signals
+                    else "inside its limits"
+                ),
+                width,
+            )
+        if found.message:
+            lines += _wrap(f"  {found.message}.", width)
     return lines
 
 
@@ -205,6 +300,14 @@ def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int 
     for side, count in (("ABOVE UPPER", cap.above_usl), ("BELOW LOWER", cap.below_lsl)):
         percent = 100.0 * count / n if n else 0.0
         lines.append(f"PIECES {side} SPEC: {count}   PERCENT {side} SPEC: {percent:.2f}")
+    found = channel.out_of_spec
+    if found is not None and found.total:
+        parts = []
+        if found.cycles_below:
+            parts.append(f"below LSL at cycles {number_list(found.cycles_below)}")
+        if found.cycles_above:
+            parts.append(f"above USL at cycles {number_list(found.cycles_above)}")
+        lines += _wrap(f"OUT OF SPEC: {found.total} readings, " + "; ".join(parts), width)
     lines.append("")
     lines += format_readings(channel.readings, decimals, width, channel.cycles or None)
     lines.append("")
@@ -225,13 +328,31 @@ def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int 
     if chart.message:
         lines += _wrap(f"  {chart.message}", width)
     if channel.alarms:
-        lines.append(f"ALARMS (rules: {config.rule_set}):")
+        lines.append(f"ALARMS (rules: {config.rule_set}; retrospective chart):")
         for alarm in channel.alarms:
-            lines += _wrap(f"{alarm.rule}: {alarm.text}", width, "  ")
+            when = "live and retrospective" if channel.alarm_is_live(alarm) else "retrospective"
+            lines += _wrap(f"{rule_name(alarm.rule)} [{when}]: {alarm.text}", width, "  ")
     else:
         lines.append(f"ALARMS (rules: {config.rule_set}): none")
+    frozen = channel.frozen
+    if frozen is not None:
+        lines += _wrap(
+            f"LIVE LIMITS (phase II, frozen from the {frozen.source or 'baseline'}): "
+            f"UCL {signed(frozen.ucl, decimals)}   CENTER {signed(frozen.center, decimals)}   "
+            f"LCL {signed(frozen.lcl, decimals)}",
+            width,
+        )
+        if channel.live_alarms:
+            lines.append("LIVE ALARMS (against the frozen limits, as raised while capturing):")
+            for alarm in channel.live_alarms:
+                lines += _wrap(f"{rule_name(alarm.rule)} [live]: {alarm.text}", width, "  ")
+        else:
+            lines.append("LIVE ALARMS (against the frozen limits): none")
     lines.append("")
-    lines += _capability_lines(cap, chart.type, decimals, width)
+    lines += _capability_lines(cap, chart.type, decimals, width, channel.verdict)
+    diagnostics = format_diagnostics(channel, decimals, width)
+    if diagnostics:
+        lines += ["", *diagnostics]
     return lines
 
 
@@ -281,7 +402,11 @@ def format_report(
         f"Unit: {config.unit or 'not given'}   Resolution: {config.resolution or 'not given'}   "
         f"Subgroup: {config.subgroup}"
     )
-    lines.append(f"Run rules: {config.rule_set}   Capable when Cpk >= {config.threshold:g}")
+    lines += _wrap(
+        f"Run rules: {config.rule_set}   Capable when Cpk >= {config.threshold:g}   "
+        f"Final verdict from {config.min_n} readings",
+        width,
+    )
     for note in notes:
         lines += _wrap(note, width)
     if analysis.excluded_cycles:

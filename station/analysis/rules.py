@@ -348,6 +348,41 @@ def _rules_of(rule_set: str) -> tuple[tuple[str, _Kind], ...]:
         raise StationError(f"unknown rule set {rule_set!r}: use one of {known}") from None
 
 
+#: Every rule's name in words, for alarm lists, reports and journal events.
+RULE_NAMES: dict[str, str] = {
+    "report-1": "a point beyond the control limits",
+    "report-2": "seven points in a row going up or down",
+    "report-3": "fifteen points in a row alternating up and down",
+    "report-4": "two of three points beyond 2 sigma on one side",
+    "we-1": "a point beyond the control limits",
+    "we-2": "two of three points beyond 2 sigma on one side",
+    "we-3": "four of five points beyond 1 sigma on one side",
+    "we-4": "eight points in a row on one side of the centre line",
+    "nelson-1": "a point beyond the control limits",
+    "nelson-2": "nine points in a row on one side of the centre line",
+    "nelson-3": "six points in a row steadily rising or falling",
+    "nelson-4": "fourteen points in a row alternating up and down",
+    "nelson-5": "two of three points beyond 2 sigma on one side",
+    "nelson-6": "four of five points beyond 1 sigma on one side",
+    "nelson-7": "fifteen points in a row within 1 sigma of the centre line",
+    "nelson-8": "eight points in a row beyond 1 sigma, on both sides",
+    "ewma": "the EWMA beyond its limits (a drift of the mean)",
+}
+_SET_WORDS = {"report": "report rule", "we": "Western Electric rule", "nelson": "Nelson rule"}
+
+
+def rule_name(rule_id: str) -> str:
+    """A rule id in words: ``report-1`` → "report rule 1 (a point beyond the control limits)";
+    an unknown id is returned as it is."""
+    words = RULE_NAMES.get(rule_id)
+    if words is None:
+        return rule_id
+    family, _, number = rule_id.partition("-")
+    if not number:
+        return f"drift rule ({words})" if rule_id == "ewma" else words
+    return f"{_SET_WORDS.get(family, family)} {number} ({words})"
+
+
 def rule_descriptions(rule_set: str) -> list[tuple[str, str]]:
     """(rule id, one-line description) of every rule in the set, for help screens and reports."""
     return [(rule_id, kind.description) for rule_id, kind in _rules_of(rule_set)]

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -24,9 +25,28 @@ import numpy as np
 from station.analysis.capability import Capability, SpecLimits, capability
 from station.analysis.charts import ControlChart, control_chart
 from station.analysis.descriptive import Descriptive, Histogram, describe, histogram
+from station.analysis.diagnostics import (
+    Autocorrelation,
+    Drift,
+    Normality,
+    OutOfSpec,
+    PercentileCapability,
+    autocorrelation,
+    drift,
+    normality,
+    out_of_spec,
+    percentile_capability,
+)
 from station.analysis.hints import channel_hints
-from station.analysis.rules import RULE_SETS, Alarm, check_rules
+from station.analysis.phases import (
+    DEFAULT_FREEZE_AFTER,
+    ControlBaseline,
+    FrozenLimits,
+    phase_two_alarms,
+)
+from station.analysis.rules import RULE_SETS, Alarm, check_rules, rule_name
 from station.analysis.spatial import AXES, Spatial, find_axes, spatial_figures
+from station.analysis.verdict import DEFAULT_MIN_N, Verdict, judge_verdict
 from station.errors import StationError
 
 NO_LIMITS_MESSAGE = "no specification limits: give limits for this channel"
@@ -53,6 +73,12 @@ class AnalysisConfig:
     threshold: float = 1.0
     confidence: float = 0.95
     nominal: Mapping[str, float] = field(default_factory=dict)
+    min_n: int = DEFAULT_MIN_N
+    """Below this many readings a verdict is PROVISIONAL (the procedure's minimum count)."""
+    freeze_after: int | None = DEFAULT_FREEZE_AFTER
+    """Chart points after which the live (phase II) limits freeze; None: no live limits."""
+    baseline: ControlBaseline | None = None
+    """Fixed phase II limits per channel (a robot's baseline); they replace the freeze."""
 
     def __post_init__(self) -> None:
         if self.resolution is not None and not self.resolution > 0:
@@ -64,6 +90,12 @@ class AnalysisConfig:
         if self.rule_set not in RULE_SETS:
             raise StationError(
                 f"unknown rule set {self.rule_set!r}; choose one of {', '.join(RULE_SETS)}."
+            )
+        if self.min_n < 0:
+            raise StationError(f"the minimum count must be 0 or more, not {self.min_n}.")
+        if self.freeze_after is not None and self.freeze_after < 2:
+            raise StationError(
+                f"the live limits need at least 2 points to freeze, not {self.freeze_after}."
             )
         if not self.threshold > 0:
             raise StationError(
@@ -97,6 +129,63 @@ class ChannelAnalysis:
     nominal: float
     cycles: tuple[int, ...] = ()
     """The cycle number of each reading (same order); the alarms' ``cycles`` come from it."""
+    verdict: Verdict | None = None
+    """The verdict word (PROVISIONAL below ``config.min_n``) and its line."""
+    out_of_spec: OutOfSpec | None = None
+    normality: Normality | None = None
+    autocorrelation: Autocorrelation | None = None
+    drift: Drift | None = None
+    frozen: FrozenLimits | None = None
+    """The phase II limits the live alarms are judged against (None: too few points yet)."""
+    phase_rules: tuple[str, str, int] = ("report", "", 1)
+    """Rule set, unit and subgroup size the live alarms are judged with."""
+    times: tuple[float, ...] = ()
+
+    @cached_property
+    def live_alarms(self) -> tuple[Alarm, ...]:
+        """The alarms against the frozen limits: those the live analysis raised. Computed on
+        first use: against limits frozen early a long drifting record raises very many."""
+        if self.frozen is None:
+            return ()
+        rule_set, unit, size = self.phase_rules
+        values = np.asarray(self.readings, dtype=float)
+        complete = len(values) // size
+        if not complete:
+            return ()
+        # The plotted points as the live analysis has them (a chart of one reading has none).
+        points = values if size == 1 else values[: complete * size].reshape(complete, size).mean(1)
+        return phase_two_alarms(
+            points.tolist(),
+            self.frozen,
+            rule_set,
+            point_cycles(self.cycles, size, complete),
+            unit=unit or None,
+        )
+
+    @cached_property
+    def percentile(self) -> PercentileCapability | None:
+        """ISO 22514-2 percentile indices when normality is rejected and limits are given
+        (None otherwise). Computed on first use: the distribution fit costs ~20 ms, too much
+        for every redraw of a live snapshot that does not show it."""
+        if self.normality is None or not self.normality.rejected or self.limits is None:
+            return None
+        return percentile_capability(self.readings, self.limits, self.capability.threshold)
+
+    @property
+    def capability_method(self) -> str:
+        """How the verdict's index was computed: the normal indices from sigma, or (normality
+        rejected) the percentile method."""
+        if self.percentile is not None:
+            return "percentile"
+        return "normal"
+
+    def alarm_is_live(self, alarm: Alarm) -> bool:
+        """True when a live (phase II) alarm of the same rule flagged one of its cycles."""
+        cycles = set(alarm.cycles)
+        return any(
+            live.rule == alarm.rule and not cycles.isdisjoint(live.cycles)
+            for live in self.live_alarms
+        )
 
 
 @dataclass(frozen=True)
@@ -216,14 +305,47 @@ def chart_alarms(
     )
 
 
+def frozen_limits_of(name: str, values: np.ndarray, config: AnalysisConfig) -> FrozenLimits | None:
+    """The phase II limits the live analysis froze (or the baseline's): the chart of the first
+    ``freeze_after`` points, or of the first points after that whose chart has a spread."""
+    if config.baseline is not None and name in config.baseline.limits:
+        return config.baseline.limits[name]
+    k = config.freeze_after
+    size = config.subgroup
+    points = len(values) // size
+    if k is None or points < k:
+        return None
+
+    def chart_of(m: int) -> ControlChart:
+        return control_chart(values[: m * size], size)
+
+    def usable(chart: ControlChart) -> bool:
+        return chart.center is not None and chart.ucl is not None and chart.ucl > chart.center
+
+    first = chart_of(k)
+    if not usable(first):
+        # A spread, once there, stays: find the first count of points with one.
+        if not usable(chart_of(points)):
+            return None
+        low, high = k, points
+        while high - low > 1:
+            middle = (low + high) // 2
+            low, high = (low, middle) if usable(chart_of(middle)) else (middle, high)
+        first, k = chart_of(high), high
+    assert first.center is not None and first.ucl is not None
+    lcl = first.lcl if first.lcl is not None else first.center
+    return FrozenLimits(first.center, first.ucl, lcl, f"first {k} points")
+
+
 def analyze_channel(
     name: str,
     values: np.ndarray | Sequence[float],
     config: AnalysisConfig,
     cycles: Sequence[int] | None = None,
+    times: Sequence[float] | None = None,
 ) -> ChannelAnalysis:
     """The full analysis of one channel's readings (in cycle order); ``cycles`` numbers them
-    (1, 2, 3 ... when None)."""
+    (1, 2, 3 ... when None); ``times`` (seconds, one per reading) date them for the trend."""
     values = np.asarray(values, dtype=float)
     labels = cycle_labels(name, cycles, len(values))
     limits = config.limits_for(name)
@@ -247,6 +369,10 @@ def analyze_channel(
             # The chart's within sigma is the estimator capability() would compute again.
             sigma_within=chart.sigma_within,
         )
+    normal = normality(values, config.resolution)
+    label_array = np.asarray(labels, dtype=int)
+    frozen = frozen_limits_of(name, values, config)
+    clock = None if times is None or len(times) != len(values) else tuple(float(t) for t in times)
     return ChannelAnalysis(
         name=name,
         descriptive=descriptive,
@@ -258,6 +384,21 @@ def analyze_channel(
         limits=limits,
         nominal=config.nominal_for(name),
         cycles=labels,
+        verdict=judge_verdict(cap, config.min_n),
+        out_of_spec=out_of_spec(values, limits, label_array),
+        normality=normal,
+        autocorrelation=autocorrelation(values, sigma_within=chart.sigma_within),
+        drift=drift(
+            values,
+            chart.sigma_within,
+            times=clock,
+            cycles=label_array,
+            name=name,
+            unit=config.unit,
+        ),
+        frozen=frozen,
+        phase_rules=(config.rule_set, config.unit, config.subgroup),
+        times=clock or (),
     )
 
 
@@ -289,7 +430,33 @@ def hints_of(channels: Sequence[ChannelAnalysis], config: AnalysisConfig) -> tup
                 unit=config.unit,
             )
         )
+        hints.extend(diagnostic_hints(channel))
     return tuple(hints)
+
+
+def diagnostic_hints(channel: ChannelAnalysis) -> list[str]:
+    """Hints from the checks of what the capability assumes: readings out of specification,
+    drift, autocorrelation and non-normal data."""
+    hints: list[str] = []
+    found = channel.out_of_spec
+    if found is not None and found.total:
+        hints.append(
+            f"{channel.name}: {found.total} reading{'s' if found.total > 1 else ''} out of "
+            f"specification ({found.below} below, {found.above} above)."
+        )
+    if channel.drift is not None and channel.drift.message:
+        hints.append(f"{channel.drift.message}.")
+    auto = channel.autocorrelation
+    if auto is not None and auto.significant and auto.message:
+        hints.append(f"{channel.name}: {auto.message}.")
+    if channel.percentile is not None and channel.normality is not None:
+        ppk = channel.percentile.ppk
+        hints.append(
+            f"{channel.name}: the readings are not normal ({channel.normality.test}, "
+            f"p = {channel.normality.p_value:.3g}): judge by the percentile index "
+            f"Ppk (percentile) {'undefined' if ppk is None else f'{ppk:.2f}'} as well as Cpk."
+        )
+    return hints
 
 
 def analyze(
@@ -298,8 +465,13 @@ def analyze(
     *,
     excluded_cycles: Sequence[int] = (),
     cycles: Mapping[str, Sequence[int]] | None = None,
+    times: Mapping[str, Sequence[float]] | None = None,
 ) -> Analysis:
     """Analyse every channel, the 3-D figures and the hints.
+
+    ``times`` maps a channel to the time (seconds) of each of its readings, for the drift's
+    trend test (a session's :meth:`~station.session.model.Session.channel_times`); without
+    them the trend is on cycle order.
 
     ``cycles`` maps a channel to the cycle number of each of its readings (a session's
     :meth:`~station.session.model.Session.channel_cycles`); a channel without an entry is
@@ -319,8 +491,9 @@ def analyze(
         if len(values) == 0:
             raise StationError(f"channel {name!r} has no readings.")
     labels = cycles or {}
+    clocks = times or {}
     analysed = {
-        name: analyze_channel(name, values, config, labels.get(name))
+        name: analyze_channel(name, values, config, labels.get(name), clocks.get(name))
         for name, values in channels.items()
     }
     return combine(analysed, config, excluded_cycles=excluded_cycles)
@@ -354,6 +527,7 @@ def _number(value: float | None) -> float | None:
 def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
     """One channel of the JSON document."""
     d, cap, chart = channel.descriptive, channel.capability, channel.chart
+    verdict = channel.verdict
     return {
         "n": d.n,
         "mean": _number(d.mean),
@@ -382,7 +556,26 @@ def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
             "above_usl": cap.above_usl,
             "below_lsl": cap.below_lsl,
             "message": cap.message,
+            "provisional": verdict.provisional if verdict else False,
+            "min_n": verdict.min_n if verdict else None,
+            "verdict": verdict.label if verdict else None,
+            "verdict_text": verdict.text if verdict else None,
+            "method": channel.capability_method,
+            "percentile": _percentile_json(channel.percentile),
         },
+        "out_of_spec": _out_of_spec_json(channel),
+        "normality": _normality_json(channel.normality),
+        "autocorrelation": _autocorrelation_json(channel.autocorrelation),
+        "drift": _drift_json(channel.drift),
+        "phase_two": None
+        if channel.frozen is None
+        else {
+            "center": _number(channel.frozen.center),
+            "ucl": _number(channel.frozen.ucl),
+            "lcl": _number(channel.frozen.lcl),
+            "source": channel.frozen.source,
+        },
+        "live_alarms": [_alarm_json(a, True) for a in channel.live_alarms],
         "chart": {
             "type": chart.type,
             "subgroup": chart.subgroup,
@@ -397,10 +590,104 @@ def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
             },
             "message": chart.message,
         },
-        "alarms": [
-            {"rule": a.rule, "points": list(a.points), "cycles": list(a.cycles), "text": a.text}
-            for a in channel.alarms
-        ],
+        "alarms": [_alarm_json(a, channel.alarm_is_live(a)) for a in channel.alarms],
+    }
+
+
+def _alarm_json(alarm: Alarm, live: bool) -> dict[str, Any]:
+    return {
+        "rule": alarm.rule,
+        "rule_name": rule_name(alarm.rule),
+        "points": list(alarm.points),
+        "cycles": list(alarm.cycles),
+        "text": alarm.text,
+        "live": live,
+    }
+
+
+def _percentile_json(result: PercentileCapability | None) -> dict[str, Any] | None:
+    if result is None:
+        return None
+    return {
+        "method": result.method,
+        "q_0_135": _number(result.q_low),
+        "median": _number(result.median),
+        "q_99_865": _number(result.q_high),
+        "pp": _number(result.pp),
+        "ppu": _number(result.ppu),
+        "ppl": _number(result.ppl),
+        "ppk": _number(result.ppk),
+        "capable": result.capable,
+    }
+
+
+def _out_of_spec_json(channel: ChannelAnalysis) -> dict[str, Any]:
+    found = channel.out_of_spec
+    if found is None:
+        return {"below": 0, "above": 0, "cycles": []}
+    return {
+        "below": found.below,
+        "above": found.above,
+        "cycles": list(found.cycles),
+        "cycles_below": list(found.cycles_below),
+        "cycles_above": list(found.cycles_above),
+    }
+
+
+def _normality_json(result: Normality | None) -> dict[str, Any] | None:
+    if result is None:
+        return None
+    return {
+        "test": result.test,
+        "statistic": _number(result.statistic),
+        "p": _number(result.p_value),
+        "alpha": result.alpha,
+        "rejected": result.rejected,
+        "ties": result.ties,
+        "message": result.message,
+    }
+
+
+def _autocorrelation_json(result: Autocorrelation | None) -> dict[str, Any] | None:
+    if result is None:
+        return None
+    return {
+        "lag1": _number(result.r1),
+        "z": _number(result.z),
+        "p": _number(result.p_value),
+        "alpha": result.alpha,
+        "significant": result.significant,
+        "sigma_ratio": _number(result.sigma_ratio),
+        "message": result.message,
+    }
+
+
+def _drift_json(result: Drift | None) -> dict[str, Any] | None:
+    if result is None:
+        return None
+    found = result.trend
+    ewma = result.ewma
+    return {
+        "trend": {
+            "basis": found.basis,
+            "span_cycles": found.span,
+            "per_span": _number(found.per_span),
+            "low": _number(found.low),
+            "high": _number(found.high),
+            "p": _number(found.p_value),
+            "significant": found.significant,
+            "cycle_seconds": _number(found.cycle_seconds),
+        },
+        "ewma": None
+        if ewma is None
+        else {
+            "lambda": ewma.lam,
+            "width": ewma.width,
+            "center": _number(ewma.center),
+            "sigma": _number(ewma.sigma),
+            "signal_cycles": list(ewma.signal_cycles),
+        },
+        "message": result.message,
     }
 
 

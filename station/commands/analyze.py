@@ -45,8 +45,8 @@ otherwise.
 
 exit codes:
   0  analysed
-  1  with --fail-if-incapable: a channel is not capable, or has no verdict (no
-     limits)
+  1  with --fail-if-incapable: a channel is not capable, has no verdict (no
+     limits) or only a provisional one (fewer readings than --min-n)
   2  bad input: missing or empty file, a cell that is not a number, impossible
      limits
 """
@@ -91,6 +91,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--capable-at",
         metavar="C",
         help="Cpk at or above which a channel is capable (default: the session's, else 1.0)",
+    )
+    parser.add_argument(
+        "--min-n",
+        metavar="N",
+        help="readings needed for a final verdict; below it the verdict is PROVISIONAL "
+        "(default: the session's procedure minimum, else 25)",
     )
     parser.add_argument("--unit", default="", help="unit of the readings, for the report")
     parser.add_argument(
@@ -228,6 +234,14 @@ def run(args: argparse.Namespace) -> int:
     except ValueError:
         raise StationError(f"--subgroup {args.subgroup!r} is not a whole number.") from None
     per_channel = [parse_limit(text) for text in args.limit]
+    min_n = None
+    if args.min_n is not None:
+        try:
+            min_n = int(args.min_n)
+        except ValueError:
+            raise StationError(f"--min-n {args.min_n!r} is not a whole number.") from None
+        if min_n < 0:
+            raise StationError(f"--min-n {min_n} must be 0 or more.")
 
     source = load_source(path)
     channels = source.channels
@@ -254,6 +268,7 @@ def run(args: argparse.Namespace) -> int:
         subgroup=subgroup,
         rule_set=args.rules or recorded.rule_set,
         threshold=recorded.threshold if threshold is None else threshold,
+        min_n=recorded.min_n if min_n is None else min_n,
     )
     procedure = args.procedure or source.analysis or "repeatability"
     from station.session.method_reports import METHOD_KINDS
@@ -298,18 +313,28 @@ def run(args: argparse.Namespace) -> int:
                 analysis,
                 title=report.title,
                 notes=report.notes,
-                sections=[list(section) for section in report.sections],
+                sections=[list(section) for section in report.sections]
+                + ([list(report.alarm_lines)] if report.alarm_lines else []),
             )
         )
     if args.fail_if_incapable:
         # A channel without a verdict (no limits, too few readings) fails too: a script that
         # asks for the verdict must not pass on data that was never judged.
         failed = [
-            f"{name} ({'not capable' if c.capability.capable is False else 'no verdict'})"
+            f"{name} ({_failure(c)})"
             for name, c in analysis.channels.items()
-            if c.capability.capable is not True
+            if c.capability.capable is not True or (c.verdict and c.verdict.provisional)
         ]
         if failed:
             print(f"station: failed the capability check: {', '.join(failed)}", file=sys.stderr)
             return 1
     return 0
+
+
+def _failure(channel: Any) -> str:
+    """Why a channel fails ``--fail-if-incapable``."""
+    if channel.capability.capable is False:
+        return "not capable"
+    if channel.verdict is not None and channel.verdict.provisional:
+        return f"provisional: {channel.verdict.n} of {channel.verdict.min_n} readings"
+    return "no verdict"

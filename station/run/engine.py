@@ -271,6 +271,7 @@ class Runner:
                         placement=cycle.placement,
                         rejected=session.rejected.get(number),
                         resolution=self.setup.resolved_resolution,
+                        times=reading_times(cycle.readings),
                     )
                 )
             self._next_cycle = session.next_cycle
@@ -758,6 +759,7 @@ class Runner:
             step_id=item.step.id,
             placement=item.placement,
             resolution=self.setup.resolved_resolution,
+            times=reading_times(readings),
         )
         self._cycles.append(record)
         self._accepted_by_step[item.key] = self._accepted_by_step.get(item.key, 0) + 1
@@ -765,7 +767,7 @@ class Runner:
         # Acknowledged: the listener hears of the reading as soon as it is on disk, with the
         # state that includes it (the last-reading line); the live figures and alarms follow.
         self._notify(self._last_event)
-        self._record_alarms(self._live.add_cycle(record.values, number))
+        self._record_alarms(self._live.add_cycle(record.values, number, record.times))
         self._notify(None, analysis=True)
         return CycleOutcome(recorded=True, message=record.line(), cycle=record)
 
@@ -834,7 +836,7 @@ class Runner:
             key = (record.step_id, record.placement)
             self._accepted_by_step[key] = self._accepted_by_step.get(key, 0) + 1
         self._accepted_count = len(accepted)
-        self._live = self._live.rebuilt([(r.values, r.cycle) for r in accepted], session)
+        self._live = self._live.rebuilt([(r.values, r.cycle, r.times) for r in accepted], session)
 
     def _item_or_none(self) -> PlanItem | None:
         return self._plan[self._position] if self._position < len(self._plan) else None
@@ -927,6 +929,15 @@ class Runner:
             self._listener(notice)
         except Exception as error:  # a display's bug must not undo a recorded event
             self._messages.append(OperatorMessage("error", f"the display failed: {error!r}"))
+
+
+def reading_times(readings: Mapping[str, Any]) -> dict[str, float] | None:
+    """Each channel's ``t_wall`` (the drift's trend runs on reading times), or None when a
+    reading has none (the trend then runs on cycle order, as the session file's analysis)."""
+    times = {channel: getattr(r, "t_wall", None) for channel, r in readings.items()}
+    if any(t is None for t in times.values()):
+        return None
+    return {channel: float(t) for channel, t in times.items()}
 
 
 def set_problem(result: CaptureResult, needed: Sequence[str], unit: str) -> str:

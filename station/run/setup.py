@@ -186,6 +186,9 @@ class SessionSetup:
                 "ports": [port.header() for port in self.ports],
             },
             "cycles_target": self.resolved_cycles,
+            # The count below which a verdict is provisional, and when the live limits freeze.
+            "cycles_min": self.procedure.cycles_min,
+            "freeze_after": self.procedure.cycles_min,
             **({"placements_target": self.placements} if self.placements else {}),
             **({"strokes_target": self.strokes} if self.strokes else {}),
             "rules": self.rule_set,

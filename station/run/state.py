@@ -135,6 +135,8 @@ class CycleRecord:
     """The reason when the cycle was rejected afterwards."""
     resolution: float | None = None
     """The session's gauge resolution: :meth:`line` shows that many decimals."""
+    times: Mapping[str, float] | None = None
+    """Each channel's reading time (``t_wall``), for the drift's trend; None when unknown."""
 
     def line(self) -> str:
         """The one-line form ``cycle 7 x=+0.0012 y=-0.0003 z=+0.0001`` (values at the

@@ -13,7 +13,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from station.analysis.capability import SpecLimits
+from station.analysis.phases import DEFAULT_FREEZE_AFTER, baseline_from_json
 from station.analysis.summary import AnalysisConfig
+from station.analysis.verdict import DEFAULT_MIN_N
 
 
 def header_limits(header: Mapping[str, Any]) -> dict[str, SpecLimits]:
@@ -35,12 +37,16 @@ def analysis_config(header: Mapping[str, Any]) -> AnalysisConfig:
     """The :class:`AnalysisConfig` a session header implies: its limits, resolution, unit, rule
     set and threshold (single readings, subgroup 1)."""
     resolution = header.get("resolution")
+    minimum, freeze = header.get("cycles_min"), header.get("freeze_after")
     return AnalysisConfig(
         limits=header_limits(header),
         resolution=float(resolution) if isinstance(resolution, int | float) else None,
         unit=str(header.get("unit") or ""),
         rule_set=str(header.get("rules") or "report"),
         threshold=float(header.get("threshold") or 1.0),
+        min_n=minimum if isinstance(minimum, int) and minimum >= 0 else DEFAULT_MIN_N,
+        freeze_after=freeze if isinstance(freeze, int) and freeze >= 2 else DEFAULT_FREEZE_AFTER,
+        baseline=baseline_from_json(header.get("baseline")),
     )
 
 

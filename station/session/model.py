@@ -52,6 +52,7 @@ EVENT_TYPES: tuple[str, ...] = (
     "reject",
     "note",
     "alarm",
+    "ack",
     "instrument",
     "samples",
     "resume",
@@ -240,6 +241,8 @@ class Session:
     """The last line's own ``hash`` field: the anchor to print (it is in the file)."""
     lines: int
     torn: TornTail | None = None
+    acks: tuple[Mapping[str, Any], ...] = ()
+    """Every ``ack`` event in order: an alarm acknowledged with its cause."""
 
     @property
     def session_id(self) -> str:
@@ -338,6 +341,21 @@ class Session:
             for channel, column in self._columns(include_rejected).items()
         }
 
+    def channel_times(self, include_rejected: bool = False) -> dict[str, np.ndarray]:
+        """The time (seconds since the epoch) of each value :meth:`channel_values` gives: the
+        reading's ``t_wall`` when the gauge reader stamped it, else its event's time ``t``."""
+        import numpy as np
+
+        numbers = sorted(self.cycles) if include_rejected else self.accepted_cycles
+        times: dict[str, list[float]] = {channel: [] for channel in self.channels}
+        for number in numbers:
+            cycle = self.cycles[number]
+            fallback = _event_seconds(cycle.t)
+            for channel, reading in cycle.readings.items():
+                stamp = reading.t_wall if reading.t_wall is not None else fallback
+                times.setdefault(channel, []).append(stamp)
+        return {channel: np.asarray(column, dtype=float) for channel, column in times.items()}
+
     def _columns(self, include_rejected: bool) -> dict[str, list[tuple[int, float]]]:
         numbers = sorted(self.cycles) if include_rejected else self.accepted_cycles
         columns: dict[str, list[tuple[int, float]]] = {channel: [] for channel in self.channels}
@@ -349,6 +367,16 @@ class Session:
 
 # --------------------------------------------------------------------------------------------
 # Replay: the one place that knows what a valid header and a valid event are
+
+
+def _event_seconds(stamp: str) -> float:
+    """An event's ISO-8601 UTC time ``t`` as seconds since the epoch (NaN when unreadable)."""
+    from datetime import datetime
+
+    try:
+        return datetime.fromisoformat(stamp.replace("Z", "+00:00")).timestamp()
+    except ValueError:
+        return math.nan
 
 
 def _is_number(value: Any) -> bool:
@@ -379,6 +407,7 @@ class Replay:
     rejected: dict[int, str] = field(default_factory=dict)
     notes: list[dict[str, Any]] = field(default_factory=list)
     alarms: list[dict[str, Any]] = field(default_factory=list)
+    acks: list[dict[str, Any]] = field(default_factory=list)
     inputs: dict[str, dict[str, Any]] = field(default_factory=dict)
     input_events: list[dict[str, Any]] = field(default_factory=list)
     zeroes: list[dict[str, Any]] = field(default_factory=list)
@@ -448,6 +477,8 @@ class Replay:
             self.notes.append(record)
         elif kind == "alarm":
             self.alarms.append(record)
+        elif kind == "ack":
+            self.acks.append(record)
         elif kind == "input":
             self.inputs[record["step"]] = record["values"]
             self.input_events.append(record)
@@ -495,6 +526,7 @@ class Replay:
             last_hash=self.last_hash or "",
             lines=lines,
             torn=torn,
+            acks=tuple(self.acks),
         )
 
 
@@ -609,6 +641,23 @@ def _check_samples(replay: Replay, record: Mapping[str, Any]) -> None:
         raise ValueError("a samples event's 't_mono' must hold one number per row")
 
 
+def _check_ack(replay: Replay, record: Mapping[str, Any]) -> None:
+    """An acknowledgement: ``alarm`` (the seq of a recorded alarm event), ``cause`` (one of the
+    procedure's causes), ``text`` (required when the cause is "other"), ``action`` (optional
+    corrective action)."""
+    alarm = record.get("alarm")
+    if not isinstance(alarm, int) or isinstance(alarm, bool):
+        raise ValueError("an ack event needs 'alarm', the seq of the alarm it acknowledges")
+    if not any(event["seq"] == alarm for event in replay.alarms):
+        raise ValueError(f"an ack names alarm {alarm}, which is not a recorded alarm event")
+    cause = _need_text(record, "cause")
+    for key in ("text", "action", "by"):
+        if key in record and not isinstance(record[key], str):
+            raise ValueError(f"an ack event's {key!r} must be text")
+    if cause == "other" and not str(record.get("text") or "").strip():
+        raise ValueError("an ack with the cause 'other' needs a 'text' saying what it was")
+
+
 def _check_free(replay: Replay, record: Mapping[str, Any]) -> None:
     """Events whose fields are free-form (alarm, instrument, resume, interrupted, finish)."""
 
@@ -621,6 +670,7 @@ _EVENT_CHECKS = {
     "reject": _check_reject,
     "note": _check_note,
     "alarm": _check_free,
+    "ack": _check_ack,
     "instrument": _check_free,
     "samples": _check_samples,
     "resume": _check_free,

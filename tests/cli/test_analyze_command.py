@@ -258,7 +258,9 @@ def test_pieces_and_alarms_are_named_by_cycle_number(tmp_path):
     text = station(path).stdout
     pieces = _pieces(text)
     assert 3 not in pieces and pieces[7] == "+0.00600" and pieces[6] == "-0.00020"
-    assert "report-1: Cycle 7 is above" in text
+    flat = " ".join(text.split())
+    assert "report rule 1 (a point beyond the control limits) [" in flat
+    assert "]: Cycle 7 is above" in flat
 
 
 def test_a_csv_cycle_column_numbers_the_readings(tmp_path):

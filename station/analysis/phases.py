@@ -1,0 +1,208 @@
+"""Phase I / phase II control limits (``reference/spc-extensions.md`` §2–§3).
+
+Phase I estimates the limits from a first set of points and judges them retrospectively: a point
+can change status as data arrive. Phase II fixes the limits (frozen after the first k points, or
+taken from a baseline) and judges each new point against them, so a signal never disappears.
+Live alarms are phase II: :class:`~station.analysis.live.LiveMonitor` raises them as readings
+arrive, and :func:`phase_two_alarms` gives the same set over all points in one pass.
+
+Beside the run rules, phase II watches the mean with an EWMA about the frozen centre line
+(λ = 0.2, L = 3; σ the frozen point sigma): a slow drift, such as a robot warming up, shows there
+long before a single point leaves the control limits.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from station.analysis.constants import SIGMA_MULTIPLE
+from station.analysis.diagnostics import EWMA_LAMBDA, EWMA_WIDTH
+from station.analysis.rules import Alarm, check_rules, number_list
+
+if TYPE_CHECKING:
+    import numpy as np
+
+#: Chart points after which the live limits freeze when the procedure names no minimum count.
+DEFAULT_FREEZE_AFTER = 20
+
+
+@dataclass(frozen=True)
+class FrozenLimits:
+    """Phase II control limits of one channel's location chart: centre line, UCL and LCL of the
+    plotted points (individuals or subgroup means), and where they came from (``source``:
+    "first 20 points", "baseline of robot R7 ..."). They never move once set."""
+
+    center: float
+    ucl: float
+    lcl: float
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        for name in ("center", "ucl", "lcl"):
+            value = getattr(self, name)
+            if not math.isfinite(value):
+                from station.errors import StationError
+
+                raise StationError(f"the baseline's {name} {value!r} is not a finite number.")
+        if not self.lcl < self.center < self.ucl:
+            from station.errors import StationError
+
+            raise StationError(
+                f"baseline limits LCL {self.lcl:g} < centre {self.center:g} < UCL {self.ucl:g} "
+                "do not hold: give a centre line between the limits."
+            )
+
+    @property
+    def point_sigma(self) -> float:
+        """The sigma of a plotted point the limits imply, (UCL − centre)/3."""
+        return (self.ucl - self.center) / SIGMA_MULTIPLE
+
+
+@dataclass(frozen=True)
+class ControlBaseline:
+    """Fixed control limits per channel (a robot's baseline, e.g. from its last accepted
+    session): the live analysis judges every reading against them from the first one."""
+
+    limits: Mapping[str, FrozenLimits] = field(default_factory=dict)
+    source: str = ""
+    """Where the baseline comes from, for the session header and the report."""
+
+
+@dataclass(frozen=True)
+class EwmaAlarms:
+    """The EWMA alarms of a run of points, and the EWMA state after the last point (its value
+    and, while it is beyond a limit, the point where that run began)."""
+
+    alarms: tuple[Alarm, ...]
+    state: float | None
+    run_start: int | None
+    side: int = 0
+
+
+def ewma_alarm(
+    points: Sequence[int],
+    cycles: Sequence[Sequence[int]],
+    value: float,
+    half_width: float,
+    frozen: FrozenLimits,
+    unit: str | None,
+) -> Alarm:
+    """One EWMA alarm over consecutive flagged ``points`` (1-based)."""
+    labels = tuple(sorted({int(c) for group in cycles for c in group}))
+    above = value > frozen.center
+    limit = frozen.center + (half_width if above else -half_width)
+    suffix = f" {unit}" if unit else ""
+    sigma = frozen.point_sigma
+    # One decimal beyond the sigma's first significant digit, as the run-rule sentences.
+    places = 4 if sigma <= 0 else max(0, min(12, 1 - math.floor(math.log10(sigma))))
+    where = (
+        f"{'Cycle' if len(labels) == 1 else 'Cycles'} {number_list(labels)}"
+        if labels
+        else f"Point {points[-1]}"
+    )
+    return Alarm(
+        "ewma",
+        tuple(points),
+        f"{where}: the EWMA ({value:+.{places}f}{suffix}) is {'above' if above else 'below'} "
+        f"its {'upper' if above else 'lower'} limit ({limit:+.{places}f}{suffix}): the mean is "
+        f"drifting {'up' if above else 'down'}; let the robot warm up, look for a loose fixture or "
+        "gauge, and repeat.",
+        labels,
+    )
+
+
+def ewma_alarms(
+    points: Sequence[float],
+    frozen: FrozenLimits,
+    cycles: Sequence[Sequence[int]],
+    *,
+    unit: str | None = None,
+    lam: float = EWMA_LAMBDA,
+    width: float = EWMA_WIDTH,
+) -> EwmaAlarms:
+    """The EWMA of ``points`` about the frozen centre (z₀ = centre, σ the frozen point sigma):
+    one alarm per run of points beyond its limits."""
+    import numpy as np
+
+    from station.analysis.diagnostics import ewma_values
+
+    if not len(points):
+        return EwmaAlarms((), None, None, 0)
+    z = ewma_values(points, frozen.center, lam)
+    index = np.arange(1, z.size + 1)
+    half = width * frozen.point_sigma * np.sqrt(lam / (2 - lam) * (1 - (1 - lam) ** (2 * index)))
+    found: list[tuple[int, Alarm]] = []
+    run_start, side = None, 0
+    for direction, flags in ((1, z - frozen.center > half), (-1, frozen.center - z > half)):
+        for run in _runs(np.flatnonzero(flags)):
+            last = run[-1] - 1
+            alarm = ewma_alarm(
+                run, [cycles[p - 1] for p in run], float(z[last]), float(half[last]), frozen, unit
+            )
+            found.append((run[0], alarm))
+            if run[-1] == z.size:
+                run_start, side = run[0], direction
+    found.sort(key=lambda item: item[0])
+    return EwmaAlarms(tuple(a for _, a in found), float(z[-1]), run_start, side)
+
+
+def _runs(indices: np.ndarray) -> list[list[int]]:
+    """Sorted 0-based indices as runs of consecutive 1-based point numbers."""
+    runs: list[list[int]] = []
+    for i in indices.tolist():
+        if runs and runs[-1][-1] == i:
+            runs[-1].append(i + 1)
+        else:
+            runs.append([i + 1])
+    return runs
+
+
+def phase_two_alarms(
+    points: Sequence[float],
+    frozen: FrozenLimits,
+    rule_set: str,
+    cycles: Sequence[Sequence[int]],
+    *,
+    unit: str | None = None,
+) -> tuple[Alarm, ...]:
+    """Every alarm of the points against frozen limits, run rules then the EWMA: the union of
+    what the live analysis flags point by point once its limits are frozen."""
+    rules = check_rules(
+        points, frozen.center, frozen.point_sigma, rule_set, unit=unit, cycles=cycles
+    )
+    return tuple(rules) + ewma_alarms(points, frozen, cycles, unit=unit).alarms
+
+
+def baseline_to_json(baseline: ControlBaseline) -> dict[str, object]:
+    """A baseline as the session header records it."""
+    return {
+        "source": baseline.source,
+        "limits": {
+            channel: {"center": f.center, "ucl": f.ucl, "lcl": f.lcl}
+            for channel, f in baseline.limits.items()
+        },
+    }
+
+
+def baseline_from_json(value: object) -> ControlBaseline | None:
+    """The baseline a session header records (None when it records none). A damaged entry is
+    a StationError naming the channel."""
+    if not isinstance(value, Mapping):
+        return None
+    source = str(value.get("source") or "baseline")
+    limits: dict[str, FrozenLimits] = {}
+    for channel, spec in (value.get("limits") or {}).items():
+        try:
+            limits[str(channel)] = FrozenLimits(
+                float(spec["center"]), float(spec["ucl"]), float(spec["lcl"]), source
+            )
+        except (KeyError, TypeError, ValueError):
+            from station.errors import StationError
+
+            raise StationError(
+                f"the baseline of channel {channel!r} needs numbers center, ucl and lcl."
+            ) from None
+    return ControlBaseline(limits, source)
