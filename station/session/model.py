@@ -38,7 +38,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from station.errors import StationError
-from station.session.durable import fsync_folder
+from station.session.durable import fsync_folder, open_append_no_follow
 
 if TYPE_CHECKING:
     import numpy as np
@@ -398,6 +398,11 @@ class Replay:
             return
         if "format" in record:
             raise ValueError("a second header in the middle of the file")
+        if self.status == "finished":
+            raise ValueError(
+                "an event after the session's finish (a finished session holds nothing more; "
+                "the line was added later)"
+            )
         seq = record.get("seq")
         if not isinstance(seq, int) or isinstance(seq, bool):
             raise ValueError("the event has no integer 'seq'")
@@ -520,6 +525,13 @@ def _check_header(record: Mapping[str, Any]) -> None:
     limits = record.get("limits", {})
     if limits is not None and not isinstance(limits, dict):
         raise ValueError("the header's 'limits' must be a table")
+    signer = record.get("signer")
+    if signer is not None and not (
+        isinstance(signer, dict)
+        and isinstance(signer.get("key"), str)
+        and isinstance(signer.get("public_key"), str)
+    ):
+        raise ValueError("the header's 'signer' needs text 'key' and 'public_key'")
     if record.get("prev", "missing") is not None:
         raise ValueError("the header's 'prev' must be null")
 
@@ -741,16 +753,18 @@ def load_session(path: str | os.PathLike[str], *, recover: bool = True) -> Sessi
     return replay.freeze(path, lines, torn)
 
 
+SESSION_FILE_LIMIT = 1 << 30
+"""The largest session file read (1 GiB, some 5 million readings): a bigger one is refused."""
+
+
 def read_session_bytes(path: Path) -> bytes:
-    """The file's bytes; StationError (exit 2) when it is missing or unreadable."""
-    try:
-        return path.read_bytes()
-    except FileNotFoundError:
-        raise StationError(f"session file {path} does not exist") from None
-    except IsADirectoryError:
-        raise StationError(f"{path} is a folder, not a session file") from None
-    except OSError as error:
-        raise StationError(f"cannot read session file {path}: {error.strerror}") from None
+    """The file's bytes; StationError (exit 2) when it is missing, unreadable, not a regular
+    file (a FIFO, a device, a folder) or larger than :data:`SESSION_FILE_LIMIT`."""
+    from station.inputfiles import read_input_bytes
+
+    if not os.path.lexists(path):
+        raise StationError(f"session file {path} does not exist")
+    return read_input_bytes(path, "session file", SESSION_FILE_LIMIT)
 
 
 def _handle_torn(path: Path, data: bytes, split: _Split, recover: bool) -> TornTail:
@@ -765,7 +779,7 @@ def _handle_torn(path: Path, data: bytes, split: _Split, recover: bool) -> TornT
         )
     torn_path = path.with_name(path.name + ".torn")
     try:
-        fd = os.open(path, os.O_RDWR)
+        fd = os.open(path, os.O_RDWR | os.O_NOFOLLOW)
     except OSError as error:
         return TornTail(
             split.kept,
@@ -794,7 +808,8 @@ def _handle_torn(path: Path, data: bytes, split: _Split, recover: bool) -> TornT
             )
         # Save the torn bytes durably (data and the .torn file's name) before cutting them from
         # the session file.
-        torn_fd = os.open(torn_path, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o640)
+        # Never through a link planted at <file>.torn (O_NOFOLLOW), only into a regular file.
+        torn_fd = open_append_no_follow(torn_path)
         try:
             _write_all(torn_fd, torn_bytes)
             os.fsync(torn_fd)

@@ -31,6 +31,7 @@ from textual.app import App
 from textual.binding import Binding
 
 from station.errors import StationError
+from station.plain import plain
 from station.tui.messages import RunnerChanged
 
 if TYPE_CHECKING:
@@ -157,7 +158,7 @@ class StationApp(App[int]):
             try:
                 runner.interrupt(reason)
             except StationError as error:
-                self.notify(error.message, severity="error")
+                self.notify(plain(error.message), severity="error", markup=False)
         self.close_instruments()
 
     def close_instruments(self) -> None:

@@ -25,8 +25,10 @@ from textual.screen import Screen
 from textual.widgets import Button, Footer, Input, Label, Select, Static
 
 from station.errors import StationError
+from station.plain import plain
 from station.tui.app import PortNotOpen
 from station.tui.messages import ConnectionTested
+from station.tui.text import shown
 from station.tui.widgets.fields import say
 
 if TYPE_CHECKING:
@@ -105,10 +107,10 @@ def parse_channel_map(text: str) -> dict[str, str]:
 def _field(label: str, widget: Any, field_id: str, hint: str = "") -> ComposeResult:
     """One labelled row, an optional hint, and the error line under it."""
     with Horizontal(classes="field-row"):
-        yield Label(label, classes="field-label")
+        yield Label(shown(label), classes="field-label")
         yield widget
     if hint:
-        yield Static(hint, classes="field-hint")
+        yield Static(shown(hint), classes="field-hint")
     yield Static("", classes="field-error", id=f"{field_id}-error")
 
 
@@ -169,7 +171,7 @@ class SetupScreen(Screen[None]):
             if resuming
             else f"New session: {procedure.title} (report §{procedure.report_section})"
         )
-        yield Static(Text(title, style="bold"), id="setup-title")
+        yield Static(shown(title, style="bold", limit=300), id="setup-title")
         hint = "Tab / Shift+Tab move between fields · F3 tests the line · F2 starts"
         if demo is not None and not resuming:
             hint = "Pre-filled for the demo: press F2 to start (F3 shows live readings first)"
@@ -181,7 +183,7 @@ class SetupScreen(Screen[None]):
                 "Robot",
                 Input(
                     compact=True,
-                    value=header.get("robot") or (demo.robot if demo else ""),
+                    value=plain(header.get("robot") or (demo.robot if demo else "")),
                     placeholder="name or asset number of the robot under test",
                     id="robot",
                     disabled=resuming,
@@ -192,7 +194,7 @@ class SetupScreen(Screen[None]):
                 "Operator",
                 Input(
                     compact=True,
-                    value=header.get("operator") or _login_name(),
+                    value=plain(header.get("operator") or _login_name()),
                     id="operator",
                     disabled=resuming,
                 ),
@@ -202,7 +204,7 @@ class SetupScreen(Screen[None]):
                 "Procedure",
                 self._select(
                     "procedure",
-                    [(f"{p.title} ({p.id})", p.id) for p in catalog.procedures],
+                    [(shown(f"{p.title} ({p.id})", limit=120), p.id) for p in catalog.procedures],
                     procedure.id,
                     disabled=resuming,
                 ),
@@ -558,7 +560,7 @@ class SetupScreen(Screen[None]):
             return
         self._testing = True
         self.query_one("#test-output", Static).update(
-            Text(f"Opening {ports[0].url} ...", style="yellow")
+            shown(f"Opening {ports[0].url} ...", style="yellow")
         )
         self._test_connection(ports, self._value("trigger"))
 
@@ -578,9 +580,9 @@ class SetupScreen(Screen[None]):
         """Show the readings (or why there are none)."""
         output = self.query_one("#test-output", Static)
         if message.error:
-            output.update(Text(message.error, style="bold red"))
+            output.update(shown(message.error, style="bold red"))
         elif message.lines:
-            output.update(Text("\n".join(message.lines), style="green"))
+            output.update(shown("\n".join(message.lines), style="green"))
         # Keep the readings and the buttons under them in view (once laid out).
         self.call_after_refresh(self._show_buttons)
         if message.done:
@@ -676,7 +678,8 @@ def _recorded_summary(header: dict[str, Any]) -> Text:
     procedure = header.get("procedure", {})
     text = Text("Recorded set-up (kept as it was):\n", style="bold")
     text.append(
-        f"robot {header.get('robot')}, operator {header.get('operator')}, procedure "
+        f"robot {plain(header.get('robot'), limit=80)}, operator "
+        f"{plain(header.get('operator'), limit=80)}, procedure "
         f"{procedure.get('id')} {procedure.get('version')}, unit {header.get('unit')}, "
         f"resolution {header.get('resolution')}, {header.get('cycles_target')} cycles.\n"
         "Check the instrument line below (the port may have changed), then press F2."

@@ -28,6 +28,7 @@ from textual.screen import Screen
 from textual.widgets import Footer, Static
 
 from station.errors import StationError
+from station.tui.text import shown
 from station.tui.widgets.alarm_log import AlarmLog, alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.deviation_plot import DeviationData, DeviationPlot, trace
@@ -266,7 +267,7 @@ class StrokeDashboardScreen(Screen[None]):
             self.show_state(state)
 
     def _say(self, text: str, style: str = "") -> None:
-        self.query_one("#dash-message", Static).update(Text(text, style=style))
+        self.query_one("#dash-message", Static).update(shown(text, style=style))
 
     # -- streaming ------------------------------------------------------------------------
 
