@@ -26,7 +26,7 @@ def check_regular_file(path: str | os.PathLike[str], what: str = "file") -> os.s
     try:
         info = os.stat(path)
     except FileNotFoundError:
-        raise StationError(f"{_shown(path)}: no such {what}; check the path.") from None
+        raise StationError(f"{_shown(path)}: no such file; check the path.") from None
     except OSError as error:
         raise StationError(f"cannot open {what} {_shown(path)}: {error.strerror}") from None
     if stat.S_ISDIR(info.st_mode):
@@ -53,7 +53,7 @@ def read_input_bytes(path: str | os.PathLike[str], what: str, limit: int) -> byt
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY | getattr(os, "O_CLOEXEC", 0))
     except OSError as error:
         if error.errno == errno.ENOENT:
-            raise StationError(f"{_shown(path)}: no such {what}; check the path.") from None
+            raise StationError(f"{_shown(path)}: no such file; check the path.") from None
         raise StationError(f"cannot open {what} {_shown(path)}: {error.strerror}") from None
     try:
         if not stat.S_ISREG(os.fstat(fd).st_mode):

@@ -54,10 +54,10 @@ class VerifyResult:
             lines += textwrap.wrap(
                 remark, width=_WIDTH, initial_indent="  ", subsequent_indent="  "
             )
-        if self.ok:
-            lines.append(f"last hash: {self.last_hash}")
         if self.key:
             lines.append(f"signed by station key: {self.key}")
+        if self.ok:
+            lines.append(f"last hash: {self.last_hash}")
         return "\n".join(lines)
 
 
