@@ -360,6 +360,19 @@ def _is_number(value: Any) -> bool:
         return False
 
 
+READING_LIMIT = 1e150
+"""The largest magnitude a recorded value or limit may have (as for CSV tables): the squares
+and sums the analysis takes stay finite."""
+CYCLE_LIMIT = 2**53
+"""Cycle numbers stay exact as floats and fit every integer array."""
+COUNT_LIMIT = 1_000_000
+"""The largest cycle, placement or stroke target a header may ask for."""
+
+
+def _is_reading(value: Any) -> bool:
+    return _is_number(value) and abs(value) <= READING_LIMIT
+
+
 def _optional_number(value: Any) -> float | None:
     return float(value) if _is_number(value) else None
 
@@ -525,6 +538,27 @@ def _check_header(record: Mapping[str, Any]) -> None:
     limits = record.get("limits", {})
     if limits is not None and not isinstance(limits, dict):
         raise ValueError("the header's 'limits' must be a table")
+    for channel, spec in (limits or {}).items():
+        if not isinstance(spec, dict):
+            raise ValueError(f"the header's limits of {channel!r} must be a table")
+        for key in ("lsl", "usl", "nominal"):
+            if spec.get(key) is not None and not _is_reading(spec[key]):
+                raise ValueError(
+                    f"the header's {key} of {channel!r} must be a finite number within "
+                    f"±{READING_LIMIT:g}"
+                )
+    for key in ("resolution", "threshold"):
+        value = record.get(key)
+        if value is not None and not (_is_reading(value) and value > 0):
+            raise ValueError(f"the header's {key!r} must be a number above 0")
+    for key in ("cycles_target", "placements_target", "strokes_target"):
+        value = record.get(key)
+        if value is not None and not (
+            isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= COUNT_LIMIT
+        ):
+            raise ValueError(f"the header's {key!r} must be a whole number from 1 to {COUNT_LIMIT}")
+    if record.get("rules") is not None and not isinstance(record.get("rules"), str):
+        raise ValueError("the header's 'rules' must be text")
     signer = record.get("signer")
     if signer is not None and not (
         isinstance(signer, dict)
@@ -545,8 +579,8 @@ def _need_text(record: Mapping[str, Any], key: str) -> str:
 
 def _need_cycle(record: Mapping[str, Any]) -> int:
     cycle = record.get("cycle")
-    if not isinstance(cycle, int) or isinstance(cycle, bool) or cycle < 1:
-        raise ValueError(f"a {record['type']} event needs a cycle number of 1 or more")
+    if not isinstance(cycle, int) or isinstance(cycle, bool) or not 1 <= cycle <= CYCLE_LIMIT:
+        raise ValueError(f"a {record['type']} event needs a cycle number from 1 to {CYCLE_LIMIT}")
     return cycle
 
 
@@ -582,8 +616,10 @@ def _check_reading(replay: Replay, record: Mapping[str, Any]) -> None:
     for channel, spec in channels.items():
         if channel not in replay.header["channels"]:
             raise ValueError(f"a reading names channel {channel!r}, not in the session")
-        if not isinstance(spec, dict) or not _is_number(spec.get("value")):
-            raise ValueError(f"a reading's channel {channel!r} needs a number 'value'")
+        if not isinstance(spec, dict) or not _is_reading(spec.get("value")):
+            raise ValueError(
+                f"a reading's channel {channel!r} needs a number 'value' within ±{READING_LIMIT:g}"
+            )
 
 
 def _check_reject(replay: Replay, record: Mapping[str, Any]) -> None:
@@ -608,7 +644,7 @@ def _check_samples(replay: Replay, record: Mapping[str, Any]) -> None:
         raise ValueError("a samples event needs 'channels', a list of the session's channels")
     values = record.get("values")
     if not isinstance(values, list) or not all(
-        isinstance(row, list) and len(row) == len(channels) and all(map(_is_number, row))
+        isinstance(row, list) and len(row) == len(channels) and all(map(_is_reading, row))
         for row in values
     ):
         raise ValueError("a samples event needs 'values', rows of one number per channel")
