@@ -8,22 +8,20 @@ their functions so that ``station --help`` and the TUI's start stay fast.
 
 from __future__ import annotations
 
-import argparse
-import contextlib
-import errno
-import importlib
-import pkgutil
-import re
+# Only sys at import time: a Ctrl-C in the first milliseconds lands in main(), which says
+# "interrupted" in one line, instead of in an import, which would print a traceback.
 import sys
-from collections.abc import Sequence
 
-from station import __version__
-from station.errors import StationError
-from station.plain import PlainStream
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    import argparse
+    from collections.abc import Sequence
 
 
 def command_names() -> list[str]:
     """The sub-commands: one per public module of :mod:`station.commands`, sorted."""
+    import pkgutil
+
     import station.commands as commands_package
 
     return sorted(
@@ -39,6 +37,11 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     Registering one command imports only its module: the TUI and each command start without
     loading the others (``station --help`` and a mistyped command still see them all).
     """
+    import argparse
+    import importlib
+
+    from station import __version__
+
     parser = argparse.ArgumentParser(
         prog="station",
         description=(
@@ -59,6 +62,20 @@ _TOP_LEVEL_FLAGS = ("-h", "--help", "--version")
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``station`` console script; returns the process exit code."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        # Ctrl-C while the command is still loading (before its own handling starts).
+        try:  # noqa: SIM105 (contextlib would be one more import in the window)
+            print("station: interrupted", file=sys.stderr)
+        except (OSError, ValueError):
+            pass
+        return 130
+
+
+def _main(argv: Sequence[str] | None) -> int:
+    from station.plain import PlainStream
+
     arguments = list(sys.argv[1:] if argv is None else argv)
     if not arguments or (arguments[0].startswith("-") and arguments[0] not in _TOP_LEVEL_FLAGS):
         # The bare command (or only options such as --no-mouse) opens the TUI.
@@ -86,6 +103,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _run(parser: argparse.ArgumentParser, arguments: list[str]) -> int:
+    import errno
+
+    from station.errors import StationError
+
     args = parser.parse_args(arguments)
     try:
         return int(args.func(args) or 0)
@@ -106,6 +127,8 @@ def _run(parser: argparse.ArgumentParser, arguments: list[str]) -> int:
 
 
 def _output_failed(stderr: object, error: OSError) -> int:
+    import contextlib
+
     with contextlib.suppress(OSError, ValueError):
         print(
             f"station: cannot write the output ({error.strerror}); free some space or "
@@ -119,13 +142,16 @@ def _output_failed(stderr: object, error: OSError) -> int:
 _FULL_SCREEN_COMMANDS = ("tui", "demo")
 """Commands that own the terminal (Textual): their text is made plain where it is shown."""
 
-_NEGATIVE = re.compile(r"^-(?:inf(?:inity)?|nan|[0-9.][0-9.eE+_-]*)$", re.IGNORECASE)
+_NEGATIVE = r"^-(?:inf(?:inity)?|nan|[0-9.][0-9.eE+_-]*)$"
 
 
 def negative_values_attached(parser: argparse.ArgumentParser, arguments: list[str]) -> list[str]:
     """``--lsl -1e-3`` as ``--lsl=-1e-3``: argparse takes a value starting with ``-`` for an
     option unless it looks like a plain negative number (``-1e-3`` and ``-inf`` do not), so an
     option that takes a value gets a negative-looking next word attached to it."""
+    import re
+
+    negative = re.compile(_NEGATIVE, re.IGNORECASE)
     takes_value: set[str] = set()
     for action in _all_actions(parser):
         if action.nargs is None and action.option_strings and not action.const:
@@ -135,7 +161,7 @@ def negative_values_attached(parser: argparse.ArgumentParser, arguments: list[st
     while index < len(arguments):
         word = arguments[index]
         following = arguments[index + 1] if index + 1 < len(arguments) else None
-        if word in takes_value and following is not None and _NEGATIVE.match(following):
+        if word in takes_value and following is not None and negative.match(following):
             joined.append(f"{word}={following}")
             index += 2
             continue
@@ -145,6 +171,8 @@ def negative_values_attached(parser: argparse.ArgumentParser, arguments: list[st
 
 
 def _all_actions(parser: argparse.ArgumentParser) -> list[argparse.Action]:
+    import argparse
+
     actions = list(parser._actions)
     for action in parser._actions:
         if isinstance(action, argparse._SubParsersAction):
