@@ -334,7 +334,11 @@ class SessionWriter:
         ):
             fd, self._fd = self._fd, None
             _close_quietly(fd)
-            what = "deleted" if named is None or opened.st_nlink == 0 else "replaced"
+            replaced = named is not None and (named.st_dev, named.st_ino) != (
+                opened.st_dev,
+                opened.st_ino,
+            )
+            what = "replaced" if replaced else "deleted"
             raise StationError(
                 f"the session file {self.path} was {what} while the session was running; "
                 "capture stopped (nothing more is acknowledged). Restore the file from a backup "
