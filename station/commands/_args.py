@@ -8,18 +8,25 @@ the same whichever command it came to.
 from __future__ import annotations
 
 import math
+import re
 
 from station.errors import StationError
+
+_DECIMAL = re.compile(
+    r"^\s*[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf|infinity|nan)\s*$",
+    re.IGNORECASE | re.ASCII,
+)
+"""A number as a person types it: ASCII digits, no ``1_000`` (Python's float() takes it), no
+other scripts' digits."""
 
 
 def parse_number(text: str | None, option: str) -> float | None:
     """A finite number given as ``option``; None when absent or blank."""
     if text is None or not text.strip():
         return None
-    try:
-        value = float(text)
-    except ValueError:
-        raise StationError(f"{option} {text!r} is not a number.") from None
+    if not _DECIMAL.match(text):
+        raise StationError(f"{option} {text!r} is not a number.")
+    value = float(text)
     if not math.isfinite(value):
         raise StationError(f"{option} {text!r} is not a finite number.")
     if abs(value) > LIMIT_MAGNITUDE:
@@ -33,6 +40,8 @@ def positive_number(text: str | None, option: str, kind: type = float) -> float 
         return None
     if kind is int:
         try:
+            if not re.fullmatch(r"\s*[+-]?\d+\s*", text, re.ASCII):
+                raise ValueError(text)
             value: float | int = int(text)
         except ValueError:
             word = "a whole number" if _is_float(text) else "a number"
@@ -71,7 +80,9 @@ def bounded_int(text: str | None, option: str, low: int, high: int) -> int | Non
     if text is None or not text.strip():
         return None
     try:
-        value = int(text.strip(), 10)
+        if not re.fullmatch(r"\s*[+-]?\d+\s*", text, re.ASCII):
+            raise ValueError(text)
+        value = int(text)
     except ValueError:
         word = "a whole number" if _is_float(text) else "a number"
         raise StationError(f"{option} {text!r} is not {word}.") from None
@@ -86,10 +97,9 @@ def limit_value(text: str | None, option: str, side: str) -> float | None:
     out. None when absent."""
     if text is None or not text.strip():
         return None
-    try:
-        value = float(text)
-    except ValueError:
-        raise StationError(f"{option} {text!r} is not a number.") from None
+    if not _DECIMAL.match(text):
+        raise StationError(f"{option} {text!r} is not a number.")
+    value = float(text)
     if math.isinf(value) and (value < 0) == (side == "lower"):
         return None
     if not math.isfinite(value):
