@@ -66,6 +66,7 @@ from __future__ import annotations
 
 import hashlib
 import importlib.resources
+import math
 import os
 import re
 import tomllib
@@ -394,7 +395,15 @@ class _Checker:
 
     def number(self, table: Mapping[str, Any], key: str, where: str, **kw: Any) -> float:
         value = self.get(table, key, (int, float), where, **kw)
-        return value if value is None else float(value)
+        if value is None:
+            return value
+        try:
+            number = float(value)
+        except OverflowError:
+            number = math.inf
+        if not math.isfinite(number):
+            raise self.fail(where, f"{key!r} must be a finite number, not {value}")
+        return number
 
     def count(self, table: Mapping[str, Any], key: str, where: str, **kw: Any) -> int | None:
         value = self.get(table, key, int, where, **kw)
@@ -454,25 +463,75 @@ _FIELD_KEYS = ("name", "label", "type", "unit", "required")
 
 def load_procedure(path: str | os.PathLike[str]) -> Procedure:
     """Read and validate one procedure file; StationError naming the file, step and fault."""
+    from station.inputfiles import read_input_bytes
+
     path = Path(path)
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise StationError(f"procedure file {path} does not exist") from None
-    except OSError as error:
-        raise StationError(f"cannot read procedure file {path}: {error.strerror}") from None
+    if not os.path.lexists(path):
+        raise StationError(f"procedure file {path} does not exist")
+    # A FIFO or a device named *.toml is refused before it is read (it would hang or grow).
+    data = read_input_bytes(path, "procedure file", PROCEDURE_FILE_LIMIT)
     return parse_procedure(data, path)
+
+
+PROCEDURE_FILE_LIMIT = 1 << 20
+"""The largest procedure file read (1 MiB; the built-in ones are a few KiB)."""
+TOML_DEPTH_LIMIT = 16
+"""The deepest nesting of arrays and inline tables a procedure file may have (tomllib recurses
+once per level: a file of ``[[[[...`` would otherwise end in a RecursionError)."""
+
+
+def toml_nesting_depth(text: str) -> int:
+    """The deepest nesting of ``[`` and ``{`` in TOML ``text`` outside strings and comments
+    (a table header ``[a]`` or ``[[a]]`` counts its brackets too). Linear, no recursion."""
+    depth = deepest = 0
+    index, length = 0, len(text)
+    while index < length:
+        char = text[index]
+        if char == "#":
+            newline = text.find("\n", index)
+            index = length if newline < 0 else newline
+            continue
+        if char in "\"'":
+            triple = text.startswith(char * 3, index)
+            quote = char * 3 if triple else char
+            index += len(quote)
+            while index < length:
+                if char == '"' and text[index] == "\\":
+                    index += 2
+                    continue
+                if text.startswith(quote, index):
+                    index += len(quote)
+                    break
+                if not triple and text[index] == "\n":
+                    break
+                index += 1
+            continue
+        if char in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif char in "]}":
+            depth = max(depth - 1, 0)
+        index += 1
+    return deepest
 
 
 def parse_procedure(data: bytes, path: Path) -> Procedure:
     """Validate the bytes of a procedure file (``path`` is used in messages and kept)."""
     check = _Checker(path)
     try:
-        table = tomllib.loads(data.decode("utf-8"))
+        text = data.decode("utf-8")
     except UnicodeDecodeError:
         raise check.fail("", "is not UTF-8 text") from None
+    if toml_nesting_depth(text) > TOML_DEPTH_LIMIT:
+        raise check.fail(
+            "", f"nests arrays or tables more than {TOML_DEPTH_LIMIT} deep; no procedure does"
+        )
+    try:
+        table = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise check.fail("", f"is not valid TOML ({error})") from None
+    except RecursionError:
+        raise check.fail("", "nests too deeply to read") from None
 
     check.only_keys(table, _TOP_KEYS, "")
     procedure_id = check.text(table, "id", "")
@@ -662,7 +721,11 @@ def _parse_limits(
         place = f"{where} {channel}"
         if isinstance(spec, list):
             if len(spec) != 2 or not all(
-                isinstance(v, int | float) and not isinstance(v, bool) for v in spec
+                isinstance(v, int | float)
+                and not isinstance(v, bool)
+                and abs(v) < 1e300
+                and math.isfinite(v)
+                for v in spec
             ):
                 raise check.fail(place, f"must be [lsl, usl] (two numbers), not {spec!r}")
             lsl, usl = float(spec[0]), float(spec[1])

@@ -9,3 +9,13 @@ import signal
 # exec; an ignored one is not).
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+import pytest  # noqa: E402
+
+
+@pytest.fixture(autouse=True)
+def _station_config_home(tmp_path_factory: pytest.TempPathFactory, monkeypatch) -> None:
+    """Every test (and every process it starts) keeps the station's signing key in a temporary
+    config folder, never in the real home."""
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path_factory.getbasetemp() / "config-home"))

@@ -9,7 +9,13 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from station.commands._args import parse_number
+from station.commands._args import (
+    RESOLUTION_RANGE,
+    bounded_int,
+    bounded_number,
+    limit_value,
+    parse_number,
+)
 from station.errors import StationError
 from station.procedures import analysis_kinds
 
@@ -20,6 +26,8 @@ RULE_CHOICES = ("report", "western-electric", "nelson")
 LINEARITY_COLUMNS = ("stroke", "s", "h", "v")
 ACCURACY_COLUMNS = ("placement", "x", "y", "z")
 PENDANT_COLUMNS = ("px", "py", "pz")
+SUBGROUP_LIMIT = 1000
+"""The largest subgroup (X̄-S charts beyond 10; a subgroup of thousands is a typo)."""
 
 DESCRIPTION = """\
 Analyse readings the way the 1990 NASA/KSC report does: maximum, average,
@@ -134,8 +142,8 @@ def parse_limit(text: str) -> tuple[str, float | None, float | None]:
             f"--limit {text!r} is not CH=LSL:USL; write e.g. --limit x=-0.001:0.001 "
             "(or x=:0.001 for an upper limit only)."
         )
-    lsl = parse_number(lsl_text, f"--limit {channel.strip()} lower limit")
-    usl = parse_number(usl_text, f"--limit {channel.strip()} upper limit")
+    lsl = limit_value(lsl_text, f"--limit {channel.strip()} lower limit", "lower")
+    usl = limit_value(usl_text, f"--limit {channel.strip()} upper limit", "upper")
     if lsl is None and usl is None:
         raise StationError(f"--limit {text!r} gives neither a lower nor an upper limit.")
     return channel.strip(), lsl, usl
@@ -225,14 +233,11 @@ def run(args: argparse.Namespace) -> int:
     from station.analysis.summary import AnalysisConfig
 
     path = Path(args.file)
-    lsl = parse_number(args.lsl, "--lsl")
-    usl = parse_number(args.usl, "--usl")
-    resolution = parse_number(args.resolution, "--resolution")
-    threshold = parse_number(args.capable_at, "--capable-at")
-    try:
-        subgroup = int(args.subgroup)
-    except ValueError:
-        raise StationError(f"--subgroup {args.subgroup!r} is not a whole number.") from None
+    lsl = limit_value(args.lsl, "--lsl", "lower")
+    usl = limit_value(args.usl, "--usl", "upper")
+    resolution = bounded_number(args.resolution, "--resolution", *RESOLUTION_RANGE)
+    threshold = bounded_number(args.capable_at, "--capable-at", 1e-6, 1e6)
+    subgroup = bounded_int(args.subgroup, "--subgroup", 1, SUBGROUP_LIMIT) or 1
     per_channel = [parse_limit(text) for text in args.limit]
     min_n = None
     if args.min_n is not None:

@@ -224,11 +224,16 @@ def _parse_inputs(items: list[str], table: str | None = None) -> Inputs:
 def _read_inputs(path: str) -> dict[int, dict[str, str]]:
     import csv
 
+    from station.inputfiles import read_input_bytes
+
+    # A regular file of at most 1 MiB (a FIFO or /dev/zero is refused), UTF-8 text.
+    data = read_input_bytes(path, "--inputs file", 1 << 20)
     try:
-        with open(path, newline="", encoding="utf-8") as handle:
-            rows = list(csv.DictReader(handle))
-    except OSError as error:
-        raise StationError(f"--inputs {path}: {error.strerror or error}") from None
+        rows = list(csv.DictReader(data.decode("utf-8-sig").splitlines()))
+    except UnicodeDecodeError:
+        raise StationError(f"--inputs {path} is not UTF-8 text; give a CSV file") from None
+    except csv.Error as error:
+        raise StationError(f"--inputs {path}: not a CSV table ({error})") from None
     table: dict[int, dict[str, str]] = {}
     for line, row in enumerate(rows, start=2):
         row = {(k or "").strip().lower(): (v or "").strip() for k, v in row.items()}
@@ -626,6 +631,8 @@ def run(args: argparse.Namespace) -> int:
     from station.session.store import sessions_folder
 
     timeout = _positive(args.timeout, "--timeout")
+    if timeout > 86_400:  # a bound time.monotonic() arithmetic and Event.wait() both take
+        raise StationError(f"--timeout must be at most 86400 seconds (a day), not {args.timeout}.")
     attempts = _positive(args.attempts, "--attempts", int)
     inputs = _parse_inputs(args.input, args.inputs)
     deadband = _positive(args.deadband, "--deadband") if args.deadband else None

@@ -72,6 +72,7 @@ def run(args: argparse.Namespace) -> int:
         raise StationError(f"--pace must be 0 or more seconds, not {args.pace}")
     if args.count is not None and args.count < 1:
         raise StationError(f"--count must be 1 or more, not {args.count}")
+    _check_demo_choice(args)
     folder, reason = sessions_folder(args.sessions)
     lab = DemoLab(args.seed)
     try:
@@ -96,3 +97,24 @@ def run(args: argparse.Namespace) -> int:
         return run_app(StationApp(config), mouse=args.mouse)
     finally:
         lab.stop()
+
+
+def _check_demo_choice(args: argparse.Namespace) -> None:
+    """A procedure that does not exist, or a --count below what its set-up accepts, is refused
+    here with a sentence (the TUI would open on it and wait forever)."""
+    from station.errors import StationError
+    from station.procedures import discover_procedures
+    from station.tui.screens.setup import count_field
+
+    catalog = discover_procedures(args.procedures)
+    if args.procedure not in catalog.ids():
+        raise StationError(
+            f"no procedure {args.procedure!r}; choose one of {', '.join(catalog.ids())}"
+        )
+    if args.count is not None:
+        count = count_field(catalog.get(args.procedure))
+        if args.count < count.minimum:
+            raise StationError(
+                f"--count {args.count} is too few for {args.procedure}: "
+                f"give at least {count.minimum} {count.noun}"
+            )

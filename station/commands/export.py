@@ -62,11 +62,15 @@ def run(args: argparse.Namespace) -> int:
         export_table(session, sys.stdout, layout, kind)
         return 0
     out = Path(args.output)
-    if out.exists() and not args.force:
-        raise StationError(f"{out} exists; pass --force to overwrite it or choose another name")
     try:
         # Synced before the rename and the folder after: OUT is whole or absent after a crash.
-        rows = replace_durably(out, lambda handle: export_table(session, handle, layout, kind))
+        # Never written through a link, and never over the session file itself.
+        rows = replace_durably(
+            out,
+            lambda handle: export_table(session, handle, layout, kind),
+            overwrite=args.force,
+            not_over=Path(args.file),
+        )
     except OSError as error:
         raise StationError(f"cannot write {out}: {error.strerror}") from None
     print(f"wrote {rows} rows to {out}", file=sys.stderr)

@@ -178,6 +178,10 @@ def run(args: argparse.Namespace) -> int:
         stopbits=args.stopbits,
         channels=tuple(channel_map) or None,
     )
+    from station.procedures import UNITS
+
+    if args.unit not in UNITS:
+        raise StationError(f"--unit {args.unit!r} is not a gauge unit; use {' or '.join(UNITS)}.")
     trigger = args.trigger or ("poll" if protocol.polled else "push")
     if trigger == "poll" and not protocol.polled:
         raise StationError(

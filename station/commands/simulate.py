@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import math
 import signal
 import sys
 import threading
+from pathlib import Path
 
-from station.commands._args import positive_number
+from station.commands._args import bounded_int, bounded_number, positive_number
 from station.errors import StationError
 
 DESCRIPTION = """\
@@ -199,7 +201,7 @@ def per_channel(text: str, name: str, channels: list[str]) -> dict[str, float]:
     """``"0.1"`` or ``"x=0.1,y=0.2"`` -> a value per channel (0 where a pair is absent)."""
     try:
         if "=" not in text:
-            return dict.fromkeys(channels, float(text))
+            return dict.fromkeys(channels, _finite(float(text), name, text))
         values = dict.fromkeys(channels, 0.0)
         for pair in text.split(","):
             channel, _, value = (part.strip() for part in pair.partition("="))
@@ -207,17 +209,28 @@ def per_channel(text: str, name: str, channels: list[str]) -> dict[str, float]:
                 raise StationError(
                     f"{name} names channel {channel!r}; the channels are {', '.join(channels)}."
                 )
-            values[channel] = float(value)
+            values[channel] = _finite(float(value), name, text)
         return values
     except ValueError:
         raise StationError(f"{name} {text!r}: give a number or CH=NUMBER pairs.") from None
 
 
-def _float(text: str, name: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        raise StationError(f"{name} {text!r} is not a number.") from None
+def _float(text: str, name: str, low: float = -1e6, high: float = 1e6) -> float:
+    value = bounded_number(text, name, low, high)
+    if value is None:
+        raise StationError(f"{name} {text!r} is not a number.")
+    return value
+
+
+def _rate(text: str, name: str) -> float:
+    """A probability, 0 to 1."""
+    return _float(text, name, 0.0, 1.0)
+
+
+def _finite(value: float, name: str, text: str) -> float:
+    if not math.isfinite(value) or abs(value) > 1e6:
+        raise StationError(f"{name} {text!r}: give finite numbers (within ±1e6).")
+    return value
 
 
 def _pair(text: str, name: str) -> tuple[float, float]:
@@ -225,6 +238,10 @@ def _pair(text: str, name: str) -> tuple[float, float]:
         low, high = (float(v) for v in text.split(","))
     except ValueError:
         raise StationError(f"{name} {text!r}: give two numbers, e.g. {name} 10,40.") from None
+    if not (math.isfinite(low) and math.isfinite(high) and abs(low) <= 1e6 and abs(high) <= 1e6):
+        raise StationError(f"{name} {text!r}: give two finite numbers.")
+    if not low < high:
+        raise StationError(f"{name} {text!r}: the first number must be below the second.")
     return low, high
 
 
@@ -234,7 +251,7 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
 
     if args.model == "fixture":
         return None
-    resolution = positive_number(args.resolution, "--resolution")
+    resolution = bounded_number(args.resolution, "--resolution", 1e-6, 1.0)
     if args.model == "gauge-bench":
         from station.instruments.gauge_bench import GaugeBenchModel
 
@@ -341,32 +358,62 @@ def build_simulator(args: argparse.Namespace):
         "backlash": per_channel(args.backlash, "--backlash", channels),
         "outlier_rate": per_channel(args.outlier_rate, "--outlier-rate", channels),
     }
+    for key in ("noise", "drift_tau", "outlier_rate"):
+        for channel, value in fields[key].items():
+            option = "--" + key.replace("_", "-")
+            if value < 0 or (key == "outlier_rate" and value > 1):
+                bound = "from 0 to 1" if key == "outlier_rate" else "0 or more"
+                raise StationError(f"{option} of {channel} must be {bound}, not {value:g}.")
     axes = {c: AxisModel(**{key: values[c] for key, values in fields.items()}) for c in channels}
     try:
-        low, high = (float(v) for v in args.range.split(","))
-    except ValueError:
-        raise StationError(f"--range {args.range!r}: give LOW,HIGH, e.g. -12.5,12.5.") from None
-    resolution = positive_number(args.resolution, "--resolution")
+        low, high = _pair(args.range, "--range")
+    except StationError:
+        raise StationError(
+            f"--range {args.range!r}: give LOW,HIGH with LOW below HIGH, e.g. -12.5,12.5."
+        ) from None
+    resolution = bounded_number(args.resolution, "--resolution", 1e-6, 1.0)
     model = _procedure_model(args, protocol, seed) or FixtureModel(
         axes, GaugeSpec(resolution, low, high, args.unit)
     )
     faults = Faults(
-        garbage_rate=_float(args.garbage_rate, "--garbage-rate"),
-        torn_rate=_float(args.torn_rate, "--torn-rate"),
-        error_rate=_float(args.error_rate, "--error-rate"),
-        silence_rate=_float(args.silence_rate, "--silence-rate"),
-        stale_rate=_float(args.stale_rate, "--stale-rate"),
-        disconnect_every=_float(args.disconnect_every, "--disconnect-every"),
-        down_time=_float(args.down_time, "--down-time"),
+        garbage_rate=_rate(args.garbage_rate, "--garbage-rate"),
+        torn_rate=_rate(args.torn_rate, "--torn-rate"),
+        error_rate=_rate(args.error_rate, "--error-rate"),
+        silence_rate=_rate(args.silence_rate, "--silence-rate"),
+        stale_rate=_rate(args.stale_rate, "--stale-rate"),
+        disconnect_every=_float(args.disconnect_every, "--disconnect-every", 0.0, 1e6),
+        down_time=_float(args.down_time, "--down-time", 0.0, 1e6),
     )
     if args.push_rate is not None:
-        push_rate = _float(args.push_rate, "--push-rate")
+        push_rate = _float(args.push_rate, "--push-rate", 0.0, 10_000.0)
     elif args.model == "bar":
         push_rate = 200.0
     else:
         push_rate = 0.0 if protocol.polled else 1.0
-    motion = build_motion(args, model, channels)
-    return Simulator(protocol, model, faults, seed, push_rate=push_rate, motion=motion)
+    try:
+        simulator = Simulator(
+            protocol,
+            model,
+            faults,
+            seed,
+            push_rate=push_rate,
+            motion=build_motion(args, model, channels),
+        )
+        # Every channel's frame must be writable at this resolution and range before serving.
+        for device, channel in simulator.channel_map.items():
+            protocol.wire_channel(device)
+            spec = getattr(model, "gauge", None) or getattr(model, "indicator", None)
+            if callable(spec):
+                spec = spec(channel)
+            if isinstance(spec, GaugeSpec):
+                for value in (spec.low, spec.high):
+                    protocol.encode(device, value, spec.resolution, spec.unit)
+    except ValueError as error:
+        raise StationError(
+            f"cannot simulate {protocol.name} with these options: {error}; use fewer channels "
+            "or a coarser --resolution."
+        ) from None
+    return simulator
 
 
 def build_motion(args: argparse.Namespace, model, channels: list[str]):
@@ -466,10 +513,8 @@ def run(args: argparse.Namespace) -> int:
     previous = {sig: signal.signal(sig, lambda *_: done.set()) for sig in stop_signals}
     try:
         if args.tcp is not None:
-            try:
-                port = int(args.tcp)
-            except ValueError:
-                raise StationError(f"--tcp {args.tcp!r} is not a port number.") from None
+            port = bounded_int(args.tcp, "--tcp", 0, 65535)
+            assert port is not None
             try:
                 url = simulator.start_tcp(port)
             except OSError as error:
@@ -478,7 +523,17 @@ def run(args: argparse.Namespace) -> int:
                     "choose another port, or 0 for a free one."
                 ) from None
         else:
-            url = simulator.start_pty(link=args.link)
+            if args.link is not None and not Path(args.link).parent.is_dir():
+                raise StationError(
+                    f"--link {args.link}: the folder {Path(args.link).parent} does not exist; "
+                    "create it or choose another path."
+                )
+            try:
+                url = simulator.start_pty(link=args.link)
+            except OSError as error:
+                raise StationError(
+                    f"cannot make the link {args.link}: {error.strerror}; choose another path."
+                ) from None
         print(url, flush=True)
         print(
             f"station: simulating {', '.join(simulator.model.channels)} "

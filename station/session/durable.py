@@ -8,7 +8,10 @@ These helpers are the one place the session code does that.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import secrets
+import stat
 from collections.abc import Callable
 from pathlib import Path
 from typing import TextIO, TypeVar
@@ -50,22 +53,105 @@ def make_folders(folder: Path) -> None:
         fsync_folder(created.parent)
 
 
-def replace_durably(path: Path, write: Callable[[TextIO], T]) -> T:
-    """Write a text file in full, or not at all: ``write(handle)`` fills a hidden ``.partial``
-    beside ``path``, which is synced, renamed over ``path``, and the folder synced. Returns what
-    ``write`` returned.
+def replace_durably(
+    path: Path,
+    write: Callable[[TextIO], T],
+    *,
+    overwrite: bool = True,
+    not_over: Path | None = None,
+) -> T:
+    """Write a text file in full, or not at all, without following a planted link.
 
-    OSError when writing fails (the partial file is removed).
+    ``write(handle)`` fills a private temporary file created beside ``path`` (``O_EXCL`` with an
+    unpredictable name, mode 0640, never through a symlink), which is synced, renamed over
+    ``path`` (a rename replaces a link at ``path`` itself, never its target), and the folder
+    synced. Returns what ``write`` returned.
+
+    Refused with a StationError, before anything is written: ``path`` is a symbolic link or not
+    a regular file, ``path`` exists and ``overwrite`` is False, or ``path`` is the same file as
+    ``not_over`` (the input being exported). OSError when writing fails (the temporary file is
+    removed).
     """
-    partial = path.with_name(f".{path.name}.partial")
+    path = Path(path)
+    check_output_path(path, overwrite=overwrite, not_over=not_over)
+    fd, partial = _private_temporary(path)
     try:
-        with open(partial, "w", encoding="utf-8", newline="") as handle:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
             result = write(handle)
             handle.flush()
             os.fsync(handle.fileno())
+        # A link or another file planted at ``path`` since the check is replaced, not followed.
+        check_output_path(path, overwrite=overwrite, not_over=not_over)
         os.replace(partial, path)
     except BaseException:
-        partial.unlink(missing_ok=True)
+        with contextlib.suppress(OSError):
+            os.unlink(partial)
         raise
     fsync_folder(path.parent)
     return result
+
+
+def write_text_durably(
+    path: Path, text: str, *, overwrite: bool = True, not_over: Path | None = None
+) -> None:
+    """:func:`replace_durably` for a whole string."""
+    replace_durably(path, lambda handle: handle.write(text), overwrite=overwrite, not_over=not_over)
+
+
+def check_output_path(path: Path, *, overwrite: bool = True, not_over: Path | None = None) -> None:
+    """StationError when ``path`` may not be written: a symbolic link, not a regular file, an
+    existing file without ``overwrite``, or the same file as ``not_over``."""
+    from station.errors import StationError
+
+    try:
+        info = os.lstat(path)
+    except FileNotFoundError:
+        return
+    except OSError as error:
+        raise StationError(f"cannot write {path}: {error.strerror}") from None
+    if stat.S_ISLNK(info.st_mode):
+        raise StationError(
+            f"{path} is a symbolic link; station does not write through links: remove it or "
+            "choose another name"
+        )
+    if not stat.S_ISREG(info.st_mode):
+        raise StationError(f"{path} is not a regular file; choose another name")
+    if not_over is not None:
+        with contextlib.suppress(OSError):
+            source = os.stat(not_over)
+            if (source.st_dev, source.st_ino) == (info.st_dev, info.st_ino):
+                raise StationError(
+                    f"{path} is the input file itself; write the output to another name"
+                )
+    if not overwrite:
+        raise StationError(f"{path} exists; pass --force to overwrite it or choose another name")
+
+
+def _private_temporary(path: Path) -> tuple[int, str]:
+    """A new file beside ``path`` with an unpredictable name: ``O_EXCL | O_NOFOLLOW``."""
+    for _ in range(100):
+        name = path.with_name(f".{path.name[:200]}.{secrets.token_hex(8)}.partial")
+        try:
+            fd = os.open(name, _NEW_FILE_FLAGS, 0o640)
+        except FileExistsError:
+            continue
+        return fd, str(name)
+    raise FileExistsError(f"no free temporary name beside {path}")
+
+
+_NEW_FILE_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | getattr(os, "O_CLOEXEC", 0)
+
+
+def open_append_no_follow(path: Path, mode: int = 0o640) -> int:
+    """A file descriptor appending to ``path`` (created when missing), never through a link:
+    ``O_NOFOLLOW`` refuses a symlink at ``path`` (OSError ``ELOOP``) and a non-regular file is
+    refused (OSError ``EINVAL``)."""
+    fd = os.open(
+        path,
+        os.O_WRONLY | os.O_CREAT | os.O_APPEND | os.O_NOFOLLOW | getattr(os, "O_CLOEXEC", 0),
+        mode,
+    )
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise OSError(errno.EINVAL, "not a regular file", str(path))
+    return fd

@@ -33,6 +33,7 @@ import os
 import re
 import signal
 import socket
+import stat
 import threading
 import unicodedata
 import uuid
@@ -42,6 +43,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from station.errors import StationError
+from station.inputfiles import check_regular_file
 from station.session.durable import fsync_folder, make_folders
 from station.session.model import (
     FORMAT,
@@ -55,6 +57,7 @@ from station.session.model import (
     read_session_bytes,
     replay_bytes,
 )
+from station.session.signing import finish_message, station_key
 
 if TYPE_CHECKING:
     pass
@@ -138,11 +141,13 @@ class SessionWriter:
         if missing:
             raise StationError(f"a session header needs {', '.join(missing)}")
         moment = now or datetime.now(UTC)
+        signer = {} if "signer" in header_fields else {"signer": station_key().header_field()}
         header = {
             "format": FORMAT,
             "session": str(uuid.uuid4()),
             "created": utc_now_iso(moment),
             "host": socket.gethostname(),
+            **signer,
             **{k: v for k, v in header_fields.items() if k not in ("format", "prev", "hash")},
         }
         line = encode_line(header, None)
@@ -172,7 +177,11 @@ class SessionWriter:
             name = f"{stem}.jsonl" if attempt == 1 else f"{stem}-{attempt}.jsonl"
             path = folder / name
             try:
-                fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_APPEND, 0o640)
+                fd = os.open(
+                    path,
+                    os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_APPEND | os.O_NOFOLLOW,
+                    0o640,
+                )
                 break
             except FileExistsError:
                 continue
@@ -201,12 +210,19 @@ class SessionWriter:
         """
         path = Path(path)
         _ignore_sigxfsz()
+        check_regular_file(path, "session file")
         try:
-            fd = os.open(path, os.O_WRONLY | os.O_APPEND)
+            fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_NOFOLLOW | os.O_NONBLOCK)
         except FileNotFoundError:
             raise StationError(f"session file {path} does not exist") from None
         except OSError as error:
+            if error.errno == errno.ELOOP:
+                raise StationError(
+                    f"session file {path} is a symbolic link; resume the file it points to"
+                ) from None
             raise StationError(f"cannot open session file {path}: {error.strerror}") from None
+        _require_regular(fd, path)
+        os.set_blocking(fd, True)
         _lock(fd, path)
         try:
             # The loader cannot take the lock we hold, so it would leave a torn tail in place:
@@ -273,7 +289,10 @@ class SessionWriter:
         with self._lock:
             if self._fd is None:
                 raise StationError(f"session file {self.path} is closed; resume it to continue")
+            self._check_still_there()
             record = {"seq": self._replay.last_seq + 1, "t": utc_now_iso(), "type": type, **fields}
+            if type == "finish" and "signer" in self._replay.header:
+                record["signature"] = self._sign_finish(record["seq"])
             line = encode_line(record, self._replay.chain_hash)
             stored = decode_line(line)
             try:
@@ -282,6 +301,49 @@ class SessionWriter:
                 raise StationError(f"cannot record the {type} event: {error}") from None
             self._write_line(line, stored)
             return stored
+
+    def _sign_finish(self, seq: int) -> str:
+        key = station_key()
+        assert key is not None
+        signer = self._replay.header["signer"]
+        if not isinstance(signer, Mapping) or signer.get("key") != key.id:
+            raise StationError(
+                f"session {self.path} was started with station key {signer.get('key')}, not "
+                f"this station's key {key.id}: finish it on the station that started it"
+            )
+        message = finish_message(
+            str(self._replay.header["session"]), self._replay.chain_hash or "", seq
+        )
+        return key.sign(message)
+
+    def _check_still_there(self) -> None:
+        """StationError when the session file was deleted, renamed away or replaced since it
+        was opened: appending to an unlinked file would acknowledge readings nobody can read."""
+        assert self._fd is not None
+        try:
+            opened = os.fstat(self._fd)
+            named = os.stat(self.path)
+        except FileNotFoundError:
+            named = None
+        except OSError:
+            return
+        if (
+            named is None
+            or opened.st_nlink == 0
+            or (named.st_dev, named.st_ino) != (opened.st_dev, opened.st_ino)
+        ):
+            fd, self._fd = self._fd, None
+            _close_quietly(fd)
+            replaced = named is not None and (named.st_dev, named.st_ino) != (
+                opened.st_dev,
+                opened.st_ino,
+            )
+            what = "replaced" if replaced else "deleted"
+            raise StationError(
+                f"the session file {self.path} was {what} while the session was running; "
+                "capture stopped (nothing more is acknowledged). Restore the file from a backup "
+                "and resume it, or start a new session"
+            )
 
     def _write_line(self, line: bytes, stored: dict[str, Any]) -> None:
         assert self._fd is not None
@@ -352,6 +414,12 @@ def _lock_again(fd: int, path: Path) -> None:
             f"session file {path} is open for writing in another station process; "
             "close that one first"
         ) from None
+
+
+def _require_regular(fd: int, path: Path) -> None:
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        _close_quietly(fd)
+        raise StationError(f"{path} is not a regular file; give a session file (.jsonl)")
 
 
 def _close_quietly(fd: int) -> None:

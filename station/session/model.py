@@ -38,7 +38,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from station.errors import StationError
-from station.session.durable import fsync_folder
+from station.session.durable import fsync_folder, open_append_no_follow
 
 if TYPE_CHECKING:
     import numpy as np
@@ -388,6 +388,19 @@ def _is_number(value: Any) -> bool:
         return False
 
 
+READING_LIMIT = 1e150
+"""The largest magnitude a recorded value or limit may have (as for CSV tables): the squares
+and sums the analysis takes stay finite."""
+CYCLE_LIMIT = 2**53
+"""Cycle numbers stay exact as floats and fit every integer array."""
+COUNT_LIMIT = 1_000_000
+"""The largest cycle, placement or stroke target a header may ask for."""
+
+
+def _is_reading(value: Any) -> bool:
+    return _is_number(value) and abs(value) <= READING_LIMIT
+
+
 def _optional_number(value: Any) -> float | None:
     return float(value) if _is_number(value) else None
 
@@ -427,6 +440,11 @@ class Replay:
             return
         if "format" in record:
             raise ValueError("a second header in the middle of the file")
+        if self.status == "finished":
+            raise ValueError(
+                "an event after the session's finish (a finished session holds nothing more; "
+                "the line was added later)"
+            )
         seq = record.get("seq")
         if not isinstance(seq, int) or isinstance(seq, bool):
             raise ValueError("the event has no integer 'seq'")
@@ -552,6 +570,34 @@ def _check_header(record: Mapping[str, Any]) -> None:
     limits = record.get("limits", {})
     if limits is not None and not isinstance(limits, dict):
         raise ValueError("the header's 'limits' must be a table")
+    for channel, spec in (limits or {}).items():
+        if not isinstance(spec, dict):
+            raise ValueError(f"the header's limits of {channel!r} must be a table")
+        for key in ("lsl", "usl", "nominal"):
+            if spec.get(key) is not None and not _is_reading(spec[key]):
+                raise ValueError(
+                    f"the header's {key} of {channel!r} must be a finite number within "
+                    f"±{READING_LIMIT:g}"
+                )
+    for key in ("resolution", "threshold"):
+        value = record.get(key)
+        if value is not None and not (_is_reading(value) and value > 0):
+            raise ValueError(f"the header's {key!r} must be a number above 0")
+    for key in ("cycles_target", "placements_target", "strokes_target"):
+        value = record.get(key)
+        if value is not None and not (
+            isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= COUNT_LIMIT
+        ):
+            raise ValueError(f"the header's {key!r} must be a whole number from 1 to {COUNT_LIMIT}")
+    if record.get("rules") is not None and not isinstance(record.get("rules"), str):
+        raise ValueError("the header's 'rules' must be text")
+    signer = record.get("signer")
+    if signer is not None and not (
+        isinstance(signer, dict)
+        and isinstance(signer.get("key"), str)
+        and isinstance(signer.get("public_key"), str)
+    ):
+        raise ValueError("the header's 'signer' needs text 'key' and 'public_key'")
     if record.get("prev", "missing") is not None:
         raise ValueError("the header's 'prev' must be null")
 
@@ -565,8 +611,8 @@ def _need_text(record: Mapping[str, Any], key: str) -> str:
 
 def _need_cycle(record: Mapping[str, Any]) -> int:
     cycle = record.get("cycle")
-    if not isinstance(cycle, int) or isinstance(cycle, bool) or cycle < 1:
-        raise ValueError(f"a {record['type']} event needs a cycle number of 1 or more")
+    if not isinstance(cycle, int) or isinstance(cycle, bool) or not 1 <= cycle <= CYCLE_LIMIT:
+        raise ValueError(f"a {record['type']} event needs a cycle number from 1 to {CYCLE_LIMIT}")
     return cycle
 
 
@@ -602,8 +648,10 @@ def _check_reading(replay: Replay, record: Mapping[str, Any]) -> None:
     for channel, spec in channels.items():
         if channel not in replay.header["channels"]:
             raise ValueError(f"a reading names channel {channel!r}, not in the session")
-        if not isinstance(spec, dict) or not _is_number(spec.get("value")):
-            raise ValueError(f"a reading's channel {channel!r} needs a number 'value'")
+        if not isinstance(spec, dict) or not _is_reading(spec.get("value")):
+            raise ValueError(
+                f"a reading's channel {channel!r} needs a number 'value' within ±{READING_LIMIT:g}"
+            )
 
 
 def _check_reject(replay: Replay, record: Mapping[str, Any]) -> None:
@@ -628,7 +676,7 @@ def _check_samples(replay: Replay, record: Mapping[str, Any]) -> None:
         raise ValueError("a samples event needs 'channels', a list of the session's channels")
     values = record.get("values")
     if not isinstance(values, list) or not all(
-        isinstance(row, list) and len(row) == len(channels) and all(map(_is_number, row))
+        isinstance(row, list) and len(row) == len(channels) and all(map(_is_reading, row))
         for row in values
     ):
         raise ValueError("a samples event needs 'values', rows of one number per channel")
@@ -791,16 +839,18 @@ def load_session(path: str | os.PathLike[str], *, recover: bool = True) -> Sessi
     return replay.freeze(path, lines, torn)
 
 
+SESSION_FILE_LIMIT = 1 << 30
+"""The largest session file read (1 GiB, some 5 million readings): a bigger one is refused."""
+
+
 def read_session_bytes(path: Path) -> bytes:
-    """The file's bytes; StationError (exit 2) when it is missing or unreadable."""
-    try:
-        return path.read_bytes()
-    except FileNotFoundError:
-        raise StationError(f"session file {path} does not exist") from None
-    except IsADirectoryError:
-        raise StationError(f"{path} is a folder, not a session file") from None
-    except OSError as error:
-        raise StationError(f"cannot read session file {path}: {error.strerror}") from None
+    """The file's bytes; StationError (exit 2) when it is missing, unreadable, not a regular
+    file (a FIFO, a device, a folder) or larger than :data:`SESSION_FILE_LIMIT`."""
+    from station.inputfiles import read_input_bytes
+
+    if not os.path.lexists(path):
+        raise StationError(f"session file {path} does not exist")
+    return read_input_bytes(path, "session file", SESSION_FILE_LIMIT)
 
 
 def _handle_torn(path: Path, data: bytes, split: _Split, recover: bool) -> TornTail:
@@ -815,7 +865,7 @@ def _handle_torn(path: Path, data: bytes, split: _Split, recover: bool) -> TornT
         )
     torn_path = path.with_name(path.name + ".torn")
     try:
-        fd = os.open(path, os.O_RDWR)
+        fd = os.open(path, os.O_RDWR | os.O_NOFOLLOW)
     except OSError as error:
         return TornTail(
             split.kept,
@@ -844,7 +894,8 @@ def _handle_torn(path: Path, data: bytes, split: _Split, recover: bool) -> TornT
             )
         # Save the torn bytes durably (data and the .torn file's name) before cutting them from
         # the session file.
-        torn_fd = os.open(torn_path, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o640)
+        # Never through a link planted at <file>.torn (O_NOFOLLOW), only into a regular file.
+        torn_fd = open_append_no_follow(torn_path)
         try:
             _write_all(torn_fd, torn_bytes)
             os.fsync(torn_fd)

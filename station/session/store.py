@@ -26,6 +26,8 @@ def sessions_folder(
     ``~/.local/share/station/sessions``). The folder is not created here; the writer creates it.
     """
     environ = os.environ if environ is None else environ
+    if explicit is not None and not str(explicit).strip():
+        raise StationError("--sessions is empty; name the sessions folder (or leave it out)")
     if explicit:
         return Path(explicit), "from --sessions"
     if environ.get(SESSIONS_ENV):

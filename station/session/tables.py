@@ -14,20 +14,19 @@ helps the line (1-based, counted in the file as an editor shows it) and the colu
 from __future__ import annotations
 
 import csv
-import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from station.errors import StationError
+from station.inputfiles import check_regular_file
+from station.plain import plain
 
 #: Column names (compared case-insensitively) that index the rows instead of holding readings.
 INDEX_COLUMNS: frozenset[str] = frozenset({"cycle", "subgroup", "t"})
-#: A header with these columns (any case) is a tidy table: one row per cycle and channel.
-TIDY_COLUMNS: frozenset[str] = frozenset({"channel", "value"})
-TIDY_VALUE_COLUMNS: frozenset[str] = frozenset({"channel", "value"})
 
 
 @dataclass(frozen=True)
@@ -60,115 +59,134 @@ class ReadingTable:
         return len(next(iter(self.channels.values())))
 
 
+#: A header with these columns (any case) is a tidy table: one row per cycle and channel.
+TIDY_COLUMNS: frozenset[str] = frozenset({"channel", "value"})
+TIDY_VALUE_COLUMNS: frozenset[str] = frozenset({"channel", "value"})
+EXPORT_COMMENT_SCAN_LIMIT = 64 << 20
+"""Files up to this size are scanned for the ``# rejected cycle N`` lines a wide export writes
+after its rows (a larger file is raw data, not an export)."""
+
+READING_LIMIT = 1e150
+"""The largest magnitude a reading may have: squares and sums of ten million of them stay
+finite floats (a 1e308 would overflow the mean and sigma into nonsense)."""
+CYCLE_LIMIT = 2**53
+"""Cycle numbers stay exact as floats and fit every integer array."""
+CSV_FILE_LIMIT = 8 << 30
+"""The largest CSV file read (8 GiB, some 500 million one-column rows)."""
+HEADER_LINE_LIMIT = 1 << 20
+
+_NUMBER = re.compile(r"^\s*[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\s*$")
+_NAMED_NUMBER = re.compile(r"^\s*[+-]?(?:inf|infinity|nan)\s*$", re.IGNORECASE)
+
+
+def _is_number_text(text: str) -> bool:
+    """True for a plain decimal number in ASCII digits (no ``1_000``, no other scripts)."""
+    return bool(_NUMBER.match(text))
+
+
 def _parse_cell(text: str, path: Path, line: int, column: str) -> float:
-    try:
+    shown = plain(text.strip(), limit=40)
+    if not text.strip():
+        what = "the cell is empty"
+    elif _NAMED_NUMBER.match(text):
+        what = f"{shown!r} is not a finite number"
+    elif not _is_number_text(text):
+        what = f"{shown!r} is not a number"
+    else:
         value = float(text)
-    except ValueError:
-        what = f"{text.strip()!r} is not a number" if text.strip() else "the cell is empty"
-        raise StationError(
-            f"{path}: line {line}, column {column!r}: {what}; fix the cell or delete the row."
-        ) from None
-    if not math.isfinite(value):
-        raise StationError(
-            f"{path}: line {line}, column {column!r}: {text.strip()!r} is not a finite number; "
-            "fix the cell or delete the row."
-        )
-    return value
+        if abs(value) <= READING_LIMIT:
+            return value
+        what = f"{shown!r} is beyond ±{READING_LIMIT:g}, not a reading"
+    raise StationError(
+        f"{plain(path)}: line {line}, column {plain(column, limit=40)!r}: {what}; "
+        "fix the cell or delete the row."
+    )
 
 
 def read_table(path: str | Path) -> ReadingTable:
     """Read a CSV table of readings: a header row, ``#`` comments, one column per channel.
 
-    Raises StationError for a missing or unreadable file, an empty file, a header without
-    channel columns, duplicate column names, a row with a different number of cells than the
-    header (naming the line), and a cell that is not a finite number (naming line and column).
+    The rows are parsed by numpy in one streaming pass (``numpy.loadtxt``, no per-cell Python);
+    a file it cannot take is read again line by line to name the first fault. Raises
+    StationError for a missing or unreadable file, a FIFO, a device or a folder, an empty file,
+    a first row of numbers (no header), a header without channel columns, duplicate column
+    names, a row with a different number of cells than the header (naming the line), a cell
+    that is not a finite number in ASCII digits within ±1e150 (naming line and column), and a
+    ``cycle`` that is not a whole number from 1 to 2**53.
     """
     path = Path(path)
-    if not path.exists():
-        raise StationError(f"{path}: no such file; check the path.")
-    if path.is_dir():
-        raise StationError(f"{path} is a folder; give the CSV file of readings.")
+    info = check_regular_file(path, "CSV file of readings")
+    if info.st_size > CSV_FILE_LIMIT:
+        raise StationError(
+            f"{plain(path)} is larger than {CSV_FILE_LIMIT >> 30} GiB; split it into smaller files."
+        )
     try:
-        text = path.read_text(encoding="utf-8-sig")
+        with open(path, encoding="utf-8-sig", newline="") as handle:
+            comments, header_line, names = _read_header(handle, path)
+            if {name.lower() for name in names} >= TIDY_COLUMNS:
+                data_rows = [
+                    (number, next(csv.reader([line])))
+                    for number, line in enumerate(handle, start=header_line + 1)
+                    if line.strip() and not line.lstrip().startswith("#")
+                ]
+                if not data_rows:
+                    raise StationError(
+                        f"{plain(path)} has a header but no readings; add one row per cycle."
+                    )
+                return _read_tidy(path, names, data_rows, tuple(comments))
+            channel_positions = _check_header(names, header_line, path)
+            start = handle.tell()
+            try:
+                data = _load_rows(handle, len(names))
+            except ValueError:
+                data = None
+            if data is None:
+                handle.seek(start)
+                try:
+                    data = _load_rows((ln for ln in handle if ln.strip()), len(names))
+                except ValueError:
+                    data = None
+            if data is None:
+                handle.seek(start)
+                _diagnose(handle, path, header_line, names)
+                raise StationError(f"{plain(path)}: the rows cannot be read as numbers.")
     except UnicodeDecodeError:
         raise StationError(
-            f"{path} is not a text file (not UTF-8); give a CSV file of readings."
+            f"{plain(path)} is not a text file (not UTF-8); give a CSV file of readings."
         ) from None
     except OSError as error:
-        raise StationError(f"{path}: cannot read the file ({error.strerror}).") from None
+        raise StationError(f"{plain(path)}: cannot read the file ({error.strerror}).") from None
 
-    comments: list[str] = []
-    numbered_rows: list[tuple[int, list[str]]] = []
-    lines = text.splitlines()
-    # csv.reader on each line separately keeps the file's own line numbers for messages;
-    # readings never contain quoted newlines.
-    for line_number, line in enumerate(lines, start=1):
-        stripped = line.strip()
-        if not stripped:
-            continue
-        if stripped.startswith("#"):
-            comments.append(stripped[1:].strip())
-            continue
-        numbered_rows.append((line_number, next(csv.reader([line]))))
-
-    if not numbered_rows:
-        raise StationError(
-            f"{path} is empty: expected a header row (e.g. 'cycle,x,y,z') and one row per cycle."
-        )
-    header_line, header = numbered_rows[0]
-    names = [name.strip() for name in header]
-    if any(not name for name in names):
-        raise StationError(
-            f"{path}: line {header_line}: the header has an empty column name; "
-            "name every column (e.g. 'cycle,x,y,z')."
-        )
-    duplicates = sorted({name for name in names if names.count(name) > 1})
-    if duplicates:
-        raise StationError(
-            f"{path}: line {header_line}: column {duplicates[0]!r} appears twice in the header; "
-            "give every column its own name."
-        )
-    channel_positions = [i for i, name in enumerate(names) if name.lower() not in INDEX_COLUMNS]
-    if not channel_positions:
-        raise StationError(
-            f"{path}: line {header_line}: no channel columns in the header {','.join(names)!r}; "
-            "add one numeric column per channel (e.g. 'x')."
-        )
-    data_rows = numbered_rows[1:]
-    if not data_rows:
-        raise StationError(f"{path} has a header but no readings; add one row per cycle.")
-    if {name.lower() for name in names} >= TIDY_COLUMNS:
-        return _read_tidy(path, names, data_rows, tuple(comments))
-
-    columns: dict[str, list[float]] = {names[i]: [] for i in channel_positions}
+    if data.shape[0] == 0:
+        raise StationError(f"{plain(path)} has a header but no readings; add one row per cycle.")
+    bad = ~np.isfinite(data) | (np.abs(data) > READING_LIMIT)
+    if bad.any():
+        # Rare: numpy took an 'inf', 'nan' or a huge value. Name the line and the cell.
+        with open(path, encoding="utf-8-sig", newline="") as handle:
+            _diagnose(handle, path, 0, names, skip_header=True)
+        raise StationError(f"{plain(path)}: a cell is not a finite number.")
     cycle_position = next((i for i, name in enumerate(names) if name.lower() == "cycle"), None)
-    cycles: list[int] = []
-    for line_number, cells in data_rows:
-        if len(cells) != len(names):
-            raise StationError(
-                f"{path}: line {line_number} has {len(cells)} cells but the header has "
-                f"{len(names)} columns; every row needs one cell per column."
-            )
-        for i in channel_positions:
-            columns[names[i]].append(_parse_cell(cells[i], path, line_number, names[i]))
-        if cycle_position is not None:
-            name = names[cycle_position]
-            number = _parse_cell(cells[cycle_position], path, line_number, name)
-            if number != int(number) or number < 1:
-                raise StationError(
-                    f"{path}: line {line_number}, column {name!r}: "
-                    f"{cells[cycle_position].strip()!r} is not a cycle number (1, 2, 3 ...); "
-                    "fix the cell or delete the row."
-                )
-            cycles.append(int(number))
-
+    cycles = None
+    if cycle_position is not None:
+        numbers = data[:, cycle_position]
+        wrong = (numbers != np.floor(numbers)) | (numbers < 1) | (numbers > CYCLE_LIMIT)
+        if wrong.any():
+            with open(path, encoding="utf-8-sig", newline="") as handle:
+                _diagnose(handle, path, 0, names, skip_header=True)
+            raise StationError(f"{plain(path)}: a cycle number is not 1, 2, 3 ...")
+        cycles = numbers.astype(np.int64)
+    if info.st_size <= EXPORT_COMMENT_SCAN_LIMIT:
+        with open(path, encoding="utf-8-sig", newline="") as handle:
+            comments = [
+                line.strip()[1:].strip() for line in handle if line.lstrip().startswith("#")
+            ]
     return ReadingTable(
         path=path,
-        channels={name: np.asarray(values, dtype=float) for name, values in columns.items()},
-        excluded_cycles=excluded_in_comments(comments),
+        channels={names[i]: np.ascontiguousarray(data[:, i]) for i in channel_positions},
         index_columns=tuple(name for name in names if name.lower() in INDEX_COLUMNS),
         comments=tuple(comments),
-        cycles=None if cycle_position is None else np.asarray(cycles, dtype=int),
+        cycles=cycles,
+        excluded_cycles=excluded_in_comments(comments),
     )
 
 
@@ -239,6 +257,100 @@ def _read_tidy(
         excluded_cycles=tuple(sorted(excluded - {c for cs in cycles.values() for c in cs})),
         placements=placements,
     )
+
+
+def _load_rows(lines: Any, columns: int) -> np.ndarray:
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # "input contained no data" for a header-only file
+        data = np.loadtxt(
+            lines, delimiter=",", comments="#", dtype=np.float64, ndmin=2, quotechar='"'
+        )
+    if data.size and data.shape[1] != columns:
+        raise ValueError("column count")
+    return data.reshape(-1, columns) if data.size else np.empty((0, columns))
+
+
+def _read_header(handle: Any, path: Path) -> tuple[list[str], int, list[str]]:
+    comments: list[str] = []
+    line_number = 0
+    while True:
+        line = handle.readline(HEADER_LINE_LIMIT)
+        if not line:
+            raise StationError(
+                f"{plain(path)} is empty: expected a header row (e.g. 'cycle,x,y,z') and one "
+                "row per cycle."
+            )
+        if len(line) >= HEADER_LINE_LIMIT:
+            raise StationError(f"{plain(path)}: line {line_number + 1} is longer than 1 MiB.")
+        line_number += 1
+        stripped = line.strip()
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            comments.append(stripped[1:].strip())
+            continue
+        cells = next(csv.reader([line]))
+        return comments, line_number, [cell.strip() for cell in cells]
+
+
+def _check_header(names: list[str], header_line: int, path: Path) -> list[int]:
+    where = f"{plain(path)}: line {header_line}"
+    if all(_is_number_text(name) or _NAMED_NUMBER.match(name) for name in names):
+        raise StationError(
+            f"{where}: the first row holds numbers, not column names; add a header row "
+            "(e.g. 'x' or 'cycle,x,y,z') so no reading is taken for a name."
+        )
+    if any(not name for name in names):
+        raise StationError(
+            f"{where}: the header has an empty column name; name every column (e.g. 'cycle,x,y,z')."
+        )
+    duplicates = sorted({name for name in names if names.count(name) > 1})
+    if duplicates:
+        raise StationError(
+            f"{where}: column {plain(duplicates[0], limit=40)!r} appears twice in the header; "
+            "give every column its own name."
+        )
+    channel_positions = [i for i, name in enumerate(names) if name.lower() not in INDEX_COLUMNS]
+    if not channel_positions:
+        raise StationError(
+            f"{where}: no channel columns in the header {plain(','.join(names), limit=80)!r}; "
+            "add one numeric column per channel (e.g. 'x')."
+        )
+    return channel_positions
+
+
+def _diagnose(
+    handle: Any, path: Path, first_line: int, names: list[str], *, skip_header: bool = False
+) -> None:
+    """Read the rows line by line (streaming, nothing kept) and raise at the first fault."""
+    line_number = first_line
+    header_seen = not skip_header
+    for line in handle:
+        line_number += 1
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        if not header_seen:
+            header_seen = True
+            continue
+        cells = next(csv.reader([line]))
+        if len(cells) != len(names):
+            raise StationError(
+                f"{plain(path)}: line {line_number} has {len(cells)} cells but the header has "
+                f"{len(names)} columns; every row needs one cell per column."
+            )
+        for index, name in enumerate(names):
+            value = _parse_cell(cells[index], path, line_number, name)
+            if name.lower() == "cycle" and (
+                value != int(value) or value < 1 or value > CYCLE_LIMIT
+            ):
+                raise StationError(
+                    f"{plain(path)}: line {line_number}, column {name!r}: "
+                    f"{plain(cells[index].strip(), limit=40)!r} is not a cycle number "
+                    "(1, 2, 3 ...); fix the cell or delete the row."
+                )
 
 
 def require_columns(

@@ -16,7 +16,7 @@ import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 
-from station.session.model import SessionFileError, read_session_bytes, replay_bytes
+from station.session.model import SessionFileError, line_hash, read_session_bytes, replay_bytes
 
 _WIDTH = 79
 
@@ -35,6 +35,10 @@ class VerifyResult:
     """The last intact line's own ``hash`` field ('' when not even the header is intact)."""
     first_bad_line: int | None
     message: str
+    key: str = ""
+    """The id of the station key the header names ('' for a session made before signing)."""
+    remarks: tuple[str, ...] = ()
+    """What the verdict does and does not show (the anchor, the signature, this station)."""
     """The verdict after the file's name: ``intact: 6 lines, ...`` or ``NOT intact: line 3:
     <fault>``."""
 
@@ -46,19 +50,35 @@ class VerifyResult:
         verdict, _, details = self.message.partition(": ")
         lines = [f"{self.path}: {verdict}"]
         lines += textwrap.wrap(details, width=_WIDTH, subsequent_indent="  ")
+        for remark in self.remarks:
+            lines += textwrap.wrap(
+                remark, width=_WIDTH, initial_indent="  ", subsequent_indent="  "
+            )
+        if self.key:
+            lines.append(f"signed by station key: {self.key}")
         if self.ok:
             lines.append(f"last hash: {self.last_hash}")
         return "\n".join(lines)
 
 
-def verify_session(path: str | os.PathLike[str]) -> VerifyResult:
+def verify_session(path: str | os.PathLike[str], anchor: str | None = None) -> VerifyResult:
     """Check a session file without changing it.
 
     A missing or unreadable file is a StationError (exit 2); a damaged one is a result with
-    ``ok`` False naming the first bad line.
+    ``ok`` False naming the first bad line. With ``anchor`` (the last hash a filed report
+    quotes) the file holds only when that is its last line's hash: a file cut short or extended
+    since the report fails. A finished session's ``finish`` must carry a valid signature by the
+    key its header names.
     """
     path = Path(path)
     data = read_session_bytes(path)
+    result = _verify_chain(path, data)
+    if not result.ok:
+        return result
+    return _verify_end(result, data, anchor)
+
+
+def _verify_chain(path: Path, data: bytes) -> VerifyResult:
     try:
         replay, lines, _ = replay_bytes(data, path, allow_torn=False)
     except SessionFileError as error:
@@ -94,3 +114,67 @@ def verify_session(path: str | os.PathLike[str]) -> VerifyResult:
             f"{len(replay.cycles)} cycles{rejected}, {replay.status}"
         ),
     )
+
+
+def _verify_end(result: VerifyResult, data: bytes, anchor: str | None) -> VerifyResult:
+    """The signature of a finished session, the anchor, and what the verdict cannot show."""
+    from dataclasses import replace
+
+    from station.session.model import decode_line
+    from station.session.signing import check_finish_signature, station_key
+
+    lines = data.split(b"\n")[:-1]
+    header = decode_line(lines[0])
+    last = decode_line(lines[-1])
+    remarks: list[str] = []
+    key = str((header.get("signer") or {}).get("key") or "")
+    if last.get("type") == "finish":
+        check = check_finish_signature(header, last)
+        if not check.ok:
+            return replace(
+                result,
+                ok=False,
+                first_bad_line=len(lines),
+                message=f"NOT intact: line {len(lines)}: {check.message}",
+                key=key,
+            )
+        if not key:
+            remarks.append(f"The finish is {check.message}.")
+    if key:
+        own = station_key(create=False)
+        if own is not None and own.id != key:
+            remarks.append(
+                f"The header names station key {key}, not this station's key {own.id}: "
+                "compare it with the key of the station that recorded the session."
+            )
+    if anchor is not None:
+        wanted = anchor.strip().lower()
+        if wanted != result.last_hash:
+            where = next(
+                (
+                    number
+                    for number, line in enumerate(lines, start=1)
+                    if decode_line(line).get("hash") == wanted or line_hash(line) == wanted
+                ),
+                None,
+            )
+            fault = (
+                f"the anchor is line {where}'s hash, not the last line's: "
+                f"{len(lines) - where} line(s) were added after the report"
+                if where is not None
+                else "the anchor is not in the file: it was cut short or rewritten since the report"
+            )
+            return replace(
+                result,
+                ok=False,
+                first_bad_line=(where + 1) if where is not None else len(lines),
+                message=f"NOT intact: {fault}",
+                key=key,
+            )
+        remarks.append("The last line is the anchor: nothing was cut or added since the report.")
+    elif result.message.endswith(("running", "interrupted")):
+        remarks.append(
+            "The chain cannot show lines cut from the end (a finished session cut short looks "
+            "unfinished): check with --anchor HASH, the last hash on the filed report."
+        )
+    return replace(result, key=key, remarks=tuple(remarks))

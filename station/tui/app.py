@@ -30,8 +30,9 @@ from textual.app import App
 from textual.binding import Binding
 
 from station.errors import StationError
+from station.plain import plain
 from station.tui.messages import RunnerChanged
-from station.tui.remedies import shown
+from station.tui.remedies import explained
 
 if TYPE_CHECKING:
     from station.procedures import ProcedureCatalog
@@ -159,7 +160,7 @@ class StationApp(App[int]):
             try:
                 runner.interrupt(reason)
             except StationError as error:
-                self.notify(shown(error), severity="error")
+                self.notify(plain(explained(error)), severity="error", markup=False)
         self.close_instruments()
 
     def close_instruments(self) -> None:

@@ -19,6 +19,6 @@ TUI_REMEDIES: dict[str, str] = {
 }
 
 
-def shown(error: StationError) -> str:
+def explained(error: StationError) -> str:
     """The error's sentence with its remedy in the TUI's words."""
     return error.worded(TUI_REMEDIES)

@@ -104,8 +104,14 @@ def test_error_rate_one_sends_only_error_frames() -> None:
         (["--protocol", "nope"], "unknown gauge protocol 'nope'"),
         (["--protocol", "sylvac"], "carries one gauge per port"),
         (["--protocol", "mitutoyo", "--bias", "q=1"], "--bias names channel 'q'"),
-        (["--protocol", "mitutoyo", "--error-rate", "2"], "error rate must lie in 0..1"),
-        (["--protocol", "mitutoyo", "--resolution", "-1"], "--resolution must be more than 0"),
+        (
+            ["--protocol", "mitutoyo", "--error-rate", "2"],
+            "--error-rate must be from 0 to 1, not 2",
+        ),
+        (
+            ["--protocol", "mitutoyo", "--resolution", "-1"],
+            "--resolution must be from 1e-06 to 1, not -1",
+        ),
     ],
 )
 def test_bad_options_exit_2_with_a_sentence(args: list[str], sentence: str) -> None:

@@ -45,8 +45,9 @@ def test_verify_exit_codes_through_the_real_cli(tmp_path: Path) -> None:
     path = make_session(tmp_path)
     intact = station("verify", str(path))
     assert intact.returncode == 0, intact.stderr
-    verdict, line, anchor = intact.stdout.splitlines()
+    verdict, line, key, anchor = intact.stdout.splitlines()
     assert verdict == f"{path}: intact" and "3 cycles, 1 rejected" in line
+    assert key.startswith("signed by station key: ")
     from station.session.model import load_session
 
     assert anchor == f"last hash: {load_session(path, recover=False).last_hash}"

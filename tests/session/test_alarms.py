@@ -7,10 +7,11 @@ import json
 
 import numpy as np
 import pytest
+from station.runner import analysis_config
+from station.session.report import analyze_session_file
 
 from station.analysis.live import LiveMonitor, replay_live_alarms
 from station.errors import StationError
-from station.runner import analysis_config
 from station.session.alarms import (
     ack_fields,
     format_recorded_alarms,
@@ -19,7 +20,6 @@ from station.session.alarms import (
 )
 from station.session.journal import SessionWriter
 from station.session.model import load_session
-from station.session.report import analyze_session_file
 
 from .conftest import session_header_fields
 

@@ -66,6 +66,8 @@ def test_export_syncs_the_file_before_the_rename_and_the_folder_after(
     out.parent.mkdir()
     synced.clear()
     assert main(["export", str(path), "--csv", "-o", str(out)]) == 0
-    partial = out.with_name(f".{out.name}.partial")
-    assert synced == [partial, out.parent], synced
+    # The private temporary file (a random name beside OUT), then the folder after the rename.
+    assert len(synced) == 2 and synced[1] == out.parent, synced
+    assert synced[0].name.startswith(f".{out.name}.") and synced[0].name.endswith(".partial")
+    assert not synced[0].exists()
     assert out.read_text().startswith("cycle,channel,value")

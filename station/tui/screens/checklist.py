@@ -19,7 +19,8 @@ from textual.screen import Screen
 from textual.widgets import Footer, Input, Label, Static
 
 from station.errors import StationError
-from station.tui.remedies import shown
+from station.tui.remedies import explained
+from station.tui.text import shown, shown_line
 from station.tui.widgets.step_list import StepList
 
 if TYPE_CHECKING:
@@ -85,7 +86,7 @@ class ChecklistScreen(Screen[None]):
         message = state.messages[-1] if state.messages else None
         if message is not None:
             style = {"error": "bold red", "warning": "yellow"}.get(message.level, "green")
-            self.query_one("#step-message", Static).update(Text(message.text, style=style))
+            self.query_one("#step-message", Static).update(shown(message.text, style=style))
 
     def _show_step(
         self, view: StepView | None, placements: int | None = None, todo: Action | None = None
@@ -103,14 +104,14 @@ class ChecklistScreen(Screen[None]):
             of = f" of {placements}" if placements else ""
             placement = f" (placement {view.placement}{of})"
         self.query_one("#step-title", Static).update(
-            Text(f"Step {view.index + 1}: {step.title}{placement}", style="bold")
+            shown(f"Step {view.index + 1}: {shown_line(step.title)}{placement}", style="bold")
         )
-        text = Text(" ".join(step.text.split()))
+        text = shown(" ".join(step.text.split()))
         asks = todo.kind if todo is not None else "confirm"
         pendant = self._demo_pendant(view) if asks == "input" else None
         if pendant is not None:
             text.append("\n\nTeach pendant (simulated): ", style="bold")
-            text.append(pendant, style="bold reverse")
+            text.append(shown_line(pendant), style="bold reverse")
         self.query_one("#step-text", Static).update(text)
         action = ENTER_DOES.get(asks, "Press Enter to continue.")
         if self.app.config.demo is not None and asks == "input":
@@ -122,7 +123,7 @@ class ChecklistScreen(Screen[None]):
             for field in todo.fields:
                 unit = f" ({field.unit})" if field.unit else ""
                 row = Horizontal(
-                    Label(f"{field.label}{unit}", classes="field-label"),
+                    Label(shown(f"{field.label}{unit}"), classes="field-label"),
                     Input(
                         compact=True,
                         id=f"input-{field.name}",
@@ -187,7 +188,7 @@ class ChecklistScreen(Screen[None]):
         try:
             call()
         except StationError as error:
-            self.app.call_from_thread(self._refused, shown(error))
+            self.app.call_from_thread(self._refused, explained(error))
         finally:
             self.app.call_from_thread(self._done)
 
@@ -195,7 +196,7 @@ class ChecklistScreen(Screen[None]):
         self.busy = False
 
     def _refused(self, sentence: str) -> None:
-        self.query_one("#step-message", Static).update(Text(sentence, style="bold red"))
+        self.query_one("#step-message", Static).update(shown(sentence, style="bold red"))
 
     def action_note(self) -> None:
         """A free-text note in the session file."""
@@ -233,7 +234,7 @@ class ChecklistScreen(Screen[None]):
 
 def _run_title(state: RunnerState) -> Text:
     """The session file's name, and the status when it is not plainly running."""
-    text = Text(f"Session {state.path.name}", style="bold")
+    text = shown(f"Session {shown_line(state.path.name)}", style="bold")
     if state.status != "running":
         text.append(f"  [{state.status.upper()}]", style="bold yellow")
     return text

@@ -23,7 +23,8 @@ from textual.widgets import Footer, Static
 
 from station.errors import StationError
 from station.tui.messages import CaptureFinished
-from station.tui.remedies import shown
+from station.tui.remedies import explained
+from station.tui.text import shown, shown_line
 from station.tui.widgets.alarm_log import AlarmLog, alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.figures import decimals_for
@@ -189,11 +190,11 @@ class DashboardScreen(Screen[None]):
         if view.channels and self.selected not in view.channels:
             self.selected = view.channels[0]
         decimals = decimals_for(view.resolution)
-        title = Text(view.title, style="bold")
+        title = shown(view.title, style="bold", limit=200)
         title.append(f"   {view.progress}", style="bold cyan")
         self.query_one("#dash-title", Static).update(title)
         self.query_one("#dash-prompt", Static).update(
-            Text(view.prompt, style="bold green" if view.ready_to_finish else "")
+            shown(view.prompt, style="bold green" if view.ready_to_finish else "")
         )
         self.query_one(StatsPanel).show(
             StatsRows(
@@ -226,7 +227,7 @@ class DashboardScreen(Screen[None]):
         self._drawn_once = True
 
     def _say(self, text: str, style: str = "") -> None:
-        self.query_one("#dash-message", Static).update(Text(text, style=style))
+        self.query_one("#dash-message", Static).update(shown(text, style=style))
 
     def _redraw(self) -> None:
         if self.view is not None:
@@ -267,7 +268,7 @@ class DashboardScreen(Screen[None]):
             outcome = runner.capture(timeout) if runner is not None else None
             self.post_message(CaptureFinished(outcome=outcome))
         except StationError as error:
-            self.post_message(CaptureFinished(error=error.message))
+            self.post_message(CaptureFinished(error=explained(error)))
 
     def on_capture_finished(self, message: CaptureFinished) -> None:
         """Say what happened; the drawing follows the runner's notice."""
@@ -290,7 +291,7 @@ class DashboardScreen(Screen[None]):
         try:
             call()
         except StationError as error:
-            self.app.call_from_thread(self._say, shown(error), "bold red")
+            self.app.call_from_thread(self._say, explained(error), "bold red")
         except Exception as error:  # a bug: shown, never swallowed by the worker
             self.app.call_from_thread(self._say, f"internal error: {error!r}", "bold red")
             raise
@@ -377,7 +378,7 @@ class DashboardScreen(Screen[None]):
         try:
             self.app.finish_session()
         except StationError as error:
-            self._say(error.message, "bold red")
+            self._say(explained(error), "bold red")
 
     def action_help(self) -> None:
         """The keys."""
@@ -415,7 +416,7 @@ def session_title(header: Mapping[str, Any]) -> str:
     """``robot R1 · repeatability`` from a session header's fields."""
     procedure = header.get("procedure")
     name = procedure.get("id", "") if isinstance(procedure, Mapping) else str(procedure or "")
-    return f"robot {header.get('robot', '?')} · {name}"
+    return f"robot {shown_line(header.get('robot', '?'), limit=60)} · {shown_line(name, limit=60)}"
 
 
 def review_view(

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Vertical, VerticalScroll
 from textual.screen import ModalScreen
 from textual.widgets import Footer, Input, Static
 
+from station.tui.text import shown
 from station.tui.widgets.fields import say
 
 
@@ -26,8 +26,8 @@ class TextPrompt(ModalScreen[str | None]):
     def compose(self) -> ComposeResult:
         """Title, question, the input, the error line."""
         with Vertical(classes="dialog"):
-            yield Static(Text(self._title, style="bold"), classes="dialog-title")
-            yield Static(self._prompt)
+            yield Static(shown(self._title, style="bold"), classes="dialog-title")
+            yield Static(shown(self._prompt))
             yield Input(placeholder=self._placeholder, id="prompt-input")
             yield Static("", classes="field-error", id="prompt-error")
             yield Static("Enter to save · Escape to cancel", classes="dim")
@@ -68,9 +68,9 @@ class ConfirmScreen(ModalScreen[bool]):
     def compose(self) -> ComposeResult:
         """The question and the keys."""
         with Vertical(classes="dialog"):
-            yield Static(Text(self._question, style="bold"), classes="dialog-title")
+            yield Static(shown(self._question, style="bold"), classes="dialog-title")
             if self._detail:
-                yield Static(self._detail)
+                yield Static(shown(self._detail))
             yield Static("y = yes · n = no", classes="dim")
         yield Footer()
 

@@ -17,7 +17,8 @@ from textual.screen import Screen
 from textual.widgets import Footer, OptionList, Static
 from textual.widgets.option_list import Option
 
-from station.tui.remedies import shown
+from station.tui.remedies import explained
+from station.tui.text import shown, shown_line
 
 if TYPE_CHECKING:
     from station.tui.app import StationApp
@@ -80,11 +81,13 @@ class HomeScreen(Screen[None]):
             self._session_count = len(list_sessions(config.sessions_dir))
         except StationError as error:
             self._unfinished, self._session_count = [], 0
-            self._load_error = shown(error)
+            self._load_error = explained(error)
         choices = self.query_one("#home-choices", OptionList)
         choices.clear_options()
         for index, summary in enumerate(self._unfinished):
-            choices.add_option(Option(_resume_label(summary), id=f"resume:{index}"))
+            choices.add_option(
+                Option(shown(_resume_label(summary), limit=300), id=f"resume:{index}")
+            )
         choices.add_option(
             Option("New session (choose the procedure, robot, limits and port)", id="new")
         )
@@ -99,10 +102,10 @@ class HomeScreen(Screen[None]):
         choices.add_option(Option("Quit", id="quit"))
         choices.highlighted = 0
         choices.focus()
-        folder = Text(f"Sessions folder: {config.sessions_dir}", style="dim")
-        folder.append(f"\n({config.sessions_reason})", style="dim")
+        folder = shown(f"Sessions folder: {shown_line(config.sessions_dir)}", style="dim")
+        folder.append(f"\n({shown_line(config.sessions_reason)})", style="dim")
         if self._load_error:
-            folder.append(f"\n{self._load_error}", style="bold red")
+            folder.append(f"\n{shown_line(self._load_error, limit=None)}", style="bold red")
         self.query_one("#home-folder", Static).update(folder)
 
     def on_option_list_option_selected(self, event: OptionList.OptionSelected) -> None:
@@ -128,7 +131,7 @@ class HomeScreen(Screen[None]):
             self.app.catalog.get(procedure_id) if procedure_id else self.app.catalog.ids()[0]
         except (StationError, IndexError) as error:
             message = getattr(error, "message", "no procedure is installed")
-            self.query_one("#home-folder", Static).update(Text(message, style="bold red"))
+            self.query_one("#home-folder", Static).update(shown(message, style="bold red"))
             return
         self.app.push_screen(SetupScreen(procedure_id=procedure_id))
 

@@ -11,7 +11,8 @@ from textual.screen import Screen
 from textual.widgets import DataTable, Footer, Static
 
 from station.errors import StationError
-from station.tui.remedies import shown
+from station.tui.remedies import explained
+from station.tui.text import shown, shown_line
 
 if TYPE_CHECKING:
     from station.tui.app import StationApp
@@ -50,7 +51,9 @@ class ReviewScreen(Screen[None]):
         table.add_columns("robot", "created (UTC)", "procedure", "status", "cycles")
         for index, summary in enumerate(self._sessions):
             if summary.error:
-                table.add_row(summary.path.name, "", "", "unreadable", "", key=str(index))
+                table.add_row(
+                    shown(summary.path.name, limit=120), "", "", "unreadable", "", key=str(index)
+                )
                 continue
             cycles = f"{summary.cycles}"
             if summary.cycles_target:
@@ -58,17 +61,17 @@ class ReviewScreen(Screen[None]):
             if summary.rejected:
                 cycles += f" ({summary.rejected} rej.)"
             table.add_row(
-                summary.robot,
-                summary.created[:19].replace("T", " "),
-                summary.procedure,
-                summary.status or "",
+                shown(summary.robot, limit=60),
+                shown(summary.created[:19].replace("T", " ")),
+                shown(summary.procedure, limit=60),
+                shown(summary.status or ""),
                 cycles,
                 key=str(index),
             )
         note = f"{len(self._sessions)} session(s) in {folder}"
         if not self._sessions:
             note = f"No session files in {folder} yet."
-        self.query_one("#review-folder", Static).update(Text(note, style="dim"))
+        self.query_one("#review-folder", Static).update(shown(note, style="dim"))
         table.focus()
 
     def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
@@ -84,12 +87,12 @@ class ReviewScreen(Screen[None]):
             return
         summary = self._sessions[table.cursor_row]
         if summary.error:
-            self.notify(summary.error, severity="error")
+            self.notify(shown_line(summary.error, limit=None), severity="error", markup=False)
             return
         try:
             view = SummaryView.from_file(summary.path)
         except StationError as error:
-            self.notify(shown(error), severity="error")
+            self.notify(shown_line(explained(error), limit=None), severity="error", markup=False)
             return
         self.app.push_screen(SummaryScreen(view, reviewing=True))
 

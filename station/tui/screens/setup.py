@@ -25,9 +25,11 @@ from textual.screen import Screen
 from textual.widgets import Button, Footer, Input, Label, Select, Static
 
 from station.errors import StationError
+from station.plain import plain
 from station.tui.app import PortNotOpen
 from station.tui.messages import ConnectionTested
-from station.tui.remedies import shown
+from station.tui.remedies import explained
+from station.tui.text import shown
 from station.tui.widgets.fields import say
 
 if TYPE_CHECKING:
@@ -106,10 +108,10 @@ def parse_channel_map(text: str) -> dict[str, str]:
 def _field(label: str, widget: Any, field_id: str, hint: str = "") -> ComposeResult:
     """One labelled row, an optional hint, and the error line under it."""
     with Horizontal(classes="field-row"):
-        yield Label(label, classes="field-label")
+        yield Label(shown(label), classes="field-label")
         yield widget
     if hint:
-        yield Static(hint, classes="field-hint")
+        yield Static(shown(hint), classes="field-hint")
     yield Static("", classes="field-error", id=f"{field_id}-error")
 
 
@@ -170,7 +172,7 @@ class SetupScreen(Screen[None]):
             if resuming
             else f"New session: {procedure.title} (report §{procedure.report_section})"
         )
-        yield Static(Text(title, style="bold"), id="setup-title")
+        yield Static(shown(title, style="bold", limit=300), id="setup-title")
         hint = "Tab / Shift+Tab move between fields · F3 tests the line · F2 starts"
         if demo is not None and not resuming:
             hint = "Pre-filled for the demo: press F2 to start (F3 shows live readings first)"
@@ -182,7 +184,7 @@ class SetupScreen(Screen[None]):
                 "Robot",
                 Input(
                     compact=True,
-                    value=header.get("robot") or (demo.robot if demo else ""),
+                    value=plain(header.get("robot") or (demo.robot if demo else "")),
                     placeholder="name or asset number of the robot under test",
                     id="robot",
                     disabled=resuming,
@@ -193,7 +195,7 @@ class SetupScreen(Screen[None]):
                 "Operator",
                 Input(
                     compact=True,
-                    value=header.get("operator") or _login_name(),
+                    value=plain(header.get("operator") or _login_name()),
                     id="operator",
                     disabled=resuming,
                 ),
@@ -203,7 +205,7 @@ class SetupScreen(Screen[None]):
                 "Procedure",
                 self._select(
                     "procedure",
-                    [(f"{p.title} ({p.id})", p.id) for p in catalog.procedures],
+                    [(shown(f"{p.title} ({p.id})", limit=120), p.id) for p in catalog.procedures],
                     procedure.id,
                     disabled=resuming,
                 ),
@@ -442,12 +444,12 @@ class SetupScreen(Screen[None]):
         try:
             protocol = get_protocol(self._value("protocol"))
         except StationError as error:
-            errors["protocol"] = shown(error)
+            errors["protocol"] = explained(error)
             protocol = None
         try:
             channel_map = parse_channel_map(self._value("map"))
         except StationError as error:
-            errors["map"] = shown(error)
+            errors["map"] = explained(error)
             channel_map = {}
         if errors.keys() & {"port", "protocol", "map"} or protocol is None:
             return ()
@@ -490,7 +492,7 @@ class SetupScreen(Screen[None]):
                     )
                 limits[channel] = SpecLimits(lsl=typed.lsl, usl=typed.usl, nominal=typed.nominal)
             except StationError as error:
-                errors[f"limits-{channel}"] = shown(error)
+                errors[f"limits-{channel}"] = explained(error)
         count = count_field(procedure)
         cycles: int | None = None
         try:
@@ -516,7 +518,7 @@ class SetupScreen(Screen[None]):
                 **{count.setup_key: cycles},
             )
         except StationError as error:
-            self._say("setup", shown(error))
+            self._say("setup", explained(error))
             return None
 
     # -- actions --------------------------------------------------------------------------
@@ -533,9 +535,9 @@ class SetupScreen(Screen[None]):
             try:
                 self.app.resume_session(self.resume_path, ports)
             except PortNotOpen as error:
-                self._refuse({"port": shown(error)})
+                self._refuse({"port": explained(error)})
             except StationError as error:
-                self._say("setup", shown(error))
+                self._say("setup", explained(error))
             return
         setup = self.read_setup()
         if setup is None:
@@ -543,9 +545,9 @@ class SetupScreen(Screen[None]):
         try:
             self.app.start_session(setup)
         except PortNotOpen as error:
-            self._refuse({"port": shown(error)})
+            self._refuse({"port": explained(error)})
         except StationError as error:
-            self._say("setup", shown(error))
+            self._say("setup", explained(error))
 
     def action_test_connection(self) -> None:
         """Open the port and show a few readings; nothing is recorded."""
@@ -559,7 +561,7 @@ class SetupScreen(Screen[None]):
             return
         self._testing = True
         self.query_one("#test-output", Static).update(
-            Text(f"Opening {ports[0].url} ...", style="yellow")
+            shown(f"Opening {ports[0].url} ...", style="yellow")
         )
         self._test_connection(ports, self._value("trigger"))
 
@@ -573,15 +575,15 @@ class SetupScreen(Screen[None]):
                 self.post_message(ConnectionTested(lines=lines))
             self.post_message(ConnectionTested(done=True))
         except StationError as error:
-            self.post_message(ConnectionTested(error=shown(error), done=True))
+            self.post_message(ConnectionTested(error=explained(error), done=True))
 
     def on_connection_tested(self, message: ConnectionTested) -> None:
         """Show the readings (or why there are none)."""
         output = self.query_one("#test-output", Static)
         if message.error:
-            output.update(Text(message.error, style="bold red"))
+            output.update(shown(message.error, style="bold red"))
         elif message.lines:
-            output.update(Text("\n".join(message.lines), style="green"))
+            output.update(shown("\n".join(message.lines), style="green"))
         # Keep the readings and the buttons under them in view (once laid out).
         self.call_after_refresh(self._show_buttons)
         if message.done:
@@ -677,7 +679,8 @@ def _recorded_summary(header: dict[str, Any]) -> Text:
     procedure = header.get("procedure", {})
     text = Text("Recorded set-up (kept as it was):\n", style="bold")
     text.append(
-        f"robot {header.get('robot')}, operator {header.get('operator')}, procedure "
+        f"robot {plain(header.get('robot'), limit=80)}, operator "
+        f"{plain(header.get('operator'), limit=80)}, procedure "
         f"{procedure.get('id')} {procedure.get('version')}, unit {header.get('unit')}, "
         f"resolution {header.get('resolution')}, {header.get('cycles_target')} cycles.\n"
         "Check the instrument line below (the port may have changed), then press F2."

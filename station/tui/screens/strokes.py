@@ -28,7 +28,8 @@ from textual.screen import Screen
 from textual.widgets import Footer, Static
 
 from station.errors import StationError
-from station.tui.remedies import shown
+from station.tui.remedies import explained
+from station.tui.text import shown
 from station.tui.widgets.alarm_log import AlarmLog, alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.deviation_plot import DeviationData, DeviationPlot, trace
@@ -265,7 +266,7 @@ class StrokeDashboardScreen(Screen[None]):
             self.show_state(state)
 
     def _say(self, text: str, style: str = "") -> None:
-        self.query_one("#dash-message", Static).update(Text(text, style=style))
+        self.query_one("#dash-message", Static).update(shown(text, style=style))
 
     # -- streaming ------------------------------------------------------------------------
 
@@ -296,7 +297,7 @@ class StrokeDashboardScreen(Screen[None]):
             runner.stream_strokes(STREAM_TIMEOUT)
             self.post_message(StreamEnded())
         except StationError as error:
-            self.post_message(StreamEnded(error=shown(error)))
+            self.post_message(StreamEnded(error=explained(error)))
 
     def on_stream_ended(self, message: StreamEnded) -> None:
         """The stream stopped: say why, and finish if the operator asked for it."""
@@ -348,7 +349,7 @@ class StrokeDashboardScreen(Screen[None]):
         try:
             self.app.finish_session()
         except StationError as error:
-            self._say(shown(error), "bold red")
+            self._say(explained(error), "bold red")
 
     # -- the rest -------------------------------------------------------------------------
 
@@ -377,7 +378,7 @@ class StrokeDashboardScreen(Screen[None]):
                 try:
                     runner.note(text)
                 except StationError as error:
-                    self._say(shown(error), "bold red")
+                    self._say(explained(error), "bold red")
 
         self.app.push_screen(TextPrompt("Note", "What should the session file say?"), callback=save)
 

@@ -22,6 +22,8 @@ from textual.screen import Screen
 from textual.widgets import Footer, Static
 
 from station.errors import StationError
+from station.tui.remedies import explained
+from station.tui.text import shown, shown_line
 from station.tui.widgets.figures import (
     VERDICT_STYLES,
     decimals_for,
@@ -127,7 +129,7 @@ def report_text(view: SummaryView) -> Text:
     accuracy per placement and across placements), as ``station analyze FILE`` prints it."""
     if view.report is None:
         return Text("")
-    return Text("\n".join(view.report.lines), no_wrap=True, overflow="crop")
+    return shown("\n".join(view.report.lines), no_wrap=True, overflow="crop")
 
 
 def verdict_text(view: SummaryView) -> Text:
@@ -146,7 +148,7 @@ def verdict_text(view: SummaryView) -> Text:
         word = verdict_word(channel.capability)
         capability = channel.capability
         descriptive = channel.descriptive
-        text.append(f"  {name}  ", style="bold")
+        text.append(f"  {shown_line(name, limit=20)}  ", style="bold")
         text.append(f"{word:<11}", style=VERDICT_STYLES[word])
         text.append(
             f" Cp {ratio(capability.cp)}  Cpk {ratio(capability.cpk)} (95%: ≥"
@@ -154,7 +156,7 @@ def verdict_text(view: SummaryView) -> Text:
             f"  σ {number(descriptive.sd, view.decimals, signed=False)}\n"
         )
         if word == "UNDEFINED" and capability.message:
-            text.append(f"      {capability.message}\n", style="yellow")
+            text.append(f"      {shown_line(capability.message, limit=None)}\n", style="yellow")
     return text
 
 
@@ -189,23 +191,23 @@ def hints_text(view: SummaryView) -> Group | Text:
     table.add_column(width=3, justify="right")
     table.add_column(ratio=1)
     for hint in hints:
-        table.add_row("•", hint)
+        table.add_row("•", shown(hint))
     return Group(Text("What the figures suggest", style="bold"), table)
 
 
 def file_text(view: SummaryView, exported: list[str]) -> Text:
     """Where the session file is, its status and the hash that anchors it."""
     text = Text("Session file\n", style="bold")
-    text.append(f"  {view.path}\n")
+    text.append(f"  {shown_line(view.path, limit=None)}\n")
     text.append(f"  status {view.status}; last line hash (write it on the filed report):\n")
     text.append(f"  {view.last_hash}\n")
     if view.excluded_cycles:
         cycles = ", ".join(str(c) for c in view.excluded_cycles)
         text.append(f"  rejected cycles, left out of the analysis: {cycles}\n")
     for note in view.notes:
-        text.append(f"  {note}\n", style="yellow")
+        text.append(f"  {shown_line(note, limit=None)}\n", style="yellow")
     for line in exported:
-        text.append(f"  {line}\n", style="green")
+        text.append(f"  {shown_line(line, limit=None)}\n", style="green")
     return text
 
 
@@ -242,8 +244,9 @@ class SummaryScreen(Screen[None]):
         procedure = header.get("procedure") or {}
         title = Text("Summary", style="bold")
         title.append(
-            f"  robot {header.get('robot', '?')} · {procedure.get('id', '')} · operator "
-            f"{header.get('operator') or 'not given'} · "
+            f"  robot {shown_line(header.get('robot', '?'), limit=60)} · "
+            f"{shown_line(procedure.get('id', ''), limit=40)} · operator "
+            f"{shown_line(header.get('operator') or 'not given', limit=60)} · "
             + (
                 (self.view.report.count if self.view.report is not None else None)
                 or f"{len(self.view.cycle_numbers)} cycles"
@@ -301,21 +304,31 @@ class SummaryScreen(Screen[None]):
         try:
             session = load_session(self.view.path, recover=False)
         except StationError as error:
-            self.notify(error.message, severity="error")
+            self.notify(shown_line(explained(error), limit=None), severity="error", markup=False)
             return
         buffer = io.StringIO()
         export_csv(session, buffer)
         self._write(self._export_path(".csv"), buffer.getvalue(), "CSV")
 
     def _write(self, target: Path, content: str, what: str) -> None:
+        from station.session.durable import write_text_durably
+
         try:
-            target.write_text(content, encoding="utf-8")
+            # Never through a link planted at the export's name, never over the session file.
+            write_text_durably(target, content, not_over=self.view.path)
+        except StationError as error:
+            self.notify(shown_line(explained(error), limit=None), severity="error", markup=False)
+            return
         except OSError as error:
-            self.notify(f"could not write {target}: {error.strerror}", severity="error")
+            self.notify(
+                shown_line(f"could not write {target}: {error.strerror}", limit=None),
+                severity="error",
+                markup=False,
+            )
             return
         self.exported.append(f"{what} exported to {target}")
         self._refresh_file()
-        self.notify(f"{what} exported to {target}")
+        self.notify(shown_line(f"{what} exported to {target}", limit=None), markup=False)
 
     def action_dashboard(self) -> None:
         """The statistics table and charts of this session, read-only."""

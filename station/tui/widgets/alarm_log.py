@@ -8,6 +8,8 @@ from typing import Any
 from rich.text import Text
 from textual.widgets import Static
 
+from station.tui.text import shown_line
+
 
 def alarm_lines(
     analyses: Mapping[str, Any], cycle_numbers: Sequence[int] | None = None, label: str = "cycle"
@@ -62,5 +64,5 @@ class AlarmLog(Static):
         )
         text = Text(head, style="bold red", no_wrap=True, overflow="ellipsis")
         for line in shown:
-            text.append("\n⚠ " + line, style="red")
+            text.append("\n⚠ " + shown_line(line), style="red")
         self.update(text)

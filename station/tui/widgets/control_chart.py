@@ -14,6 +14,7 @@ from typing import Any
 from rich.text import Text
 from textual.widget import Widget
 
+from station.tui.text import shown_line
 from station.tui.widgets.figures import number
 
 _GUTTER = 13  # "UCL +0.00031 " fits; values outside are written in the rows they fall on
@@ -68,7 +69,10 @@ def chart_data(
         alarm_points=frozenset(alarmed),
         labels=labels,
         decimals=decimals,
-        title=f"{getattr(chart, 'type', 'control')} chart {getattr(channel, 'name', '')}".strip(),
+        title=(
+            f"{getattr(chart, 'type', 'control')} chart "
+            f"{shown_line(getattr(channel, 'name', ''), limit=20)}"
+        ).strip(),
         message=str(getattr(chart, "message", "") or ""),
         label=label,
     )

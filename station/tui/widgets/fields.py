@@ -4,8 +4,10 @@ from __future__ import annotations
 
 from textual.widgets import Static
 
+from station.tui.text import shown
+
 
 def say(error_line: Static, sentence: str) -> None:
     """Show a sentence on a field's error line, or hide the line when the sentence is empty."""
-    error_line.update(sentence)
+    error_line.update(shown(sentence))
     error_line.set_class(bool(sentence), "-shown")

@@ -13,6 +13,7 @@ from typing import Any
 from rich.text import Text
 from textual.widget import Widget
 
+from station.tui.text import shown_line
 from station.tui.widgets.figures import number
 
 _EIGHTHS = " ▁▂▃▄▅▆▇█"
@@ -42,7 +43,7 @@ def histogram_data(channel: Any, decimals: int) -> HistogramData | None:
         lsl=getattr(capability, "lsl", None),
         usl=getattr(capability, "usl", None),
         decimals=decimals,
-        title=f"histogram {getattr(channel, 'name', '')}",
+        title=f"histogram {shown_line(getattr(channel, 'name', ''), limit=20)}",
     )
 
 

@@ -8,6 +8,8 @@ from typing import Any
 from rich.text import Text
 from textual.widgets import Static
 
+from station.tui.text import shown_line
+
 _STATUS_STYLES = {"connected": "green", "connecting": "yellow", "disconnected": "bold red"}
 
 
@@ -21,7 +23,7 @@ def status_text(ports: Sequence[Any]) -> Text:
         shown = "reconnecting" if status == "disconnected" else status
         if index:
             text.append("  ")
-        text.append(f"{getattr(port, 'url', '?')}: ")
+        text.append(f"{shown_line(getattr(port, 'url', '?'))}: ")
         text.append(shown, style=_STATUS_STYLES.get(status, ""))
         rejected = int(getattr(port, "rejected_frames", 0) or 0)
         text.append(
@@ -30,7 +32,7 @@ def status_text(ports: Sequence[Any]) -> Text:
         )
         detail = str(getattr(port, "detail", "") or "")
         if detail and status != "connected":
-            text.append(f" ({detail})", style="dim")
+            text.append(f" ({shown_line(detail)})", style="dim")
     return text
 
 

@@ -16,6 +16,7 @@ from rich.table import Table
 from rich.text import Text
 from textual.widgets import Static
 
+from station.tui.text import shown_line
 from station.tui.widgets.figures import VERDICT_STYLES, number, ratio, verdict_word
 
 
@@ -48,7 +49,7 @@ def stats_table(rows: StatsRows) -> Table:
         word = verdict_word(capability) if analysis is not None else "—"
         marker = "▶" if channel == rows.selected else " "
         table.add_row(
-            Text(f"{marker}{channel}", style="bold"),
+            Text(f"{marker}{shown_line(channel, limit=20)}", style="bold"),
             number(rows.last.get(channel), rows.decimals),
             str(getattr(descriptive, "n", 0)),
             number(getattr(descriptive, "mean", None), rows.decimals),

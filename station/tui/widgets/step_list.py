@@ -8,6 +8,8 @@ from typing import Any
 from rich.text import Text
 from textual.widgets import Static
 
+from station.tui.text import shown_line
+
 MARKS = {"done": ("✓", "green"), "current": ("▶", "bold"), "pending": ("·", "dim")}
 
 
@@ -22,7 +24,7 @@ def steps_text(steps: Sequence[Any]) -> Text:
             title = f"{title} ({placement})"
         if index:
             text.append("\n")
-        text.append(f"{mark} {index + 1:>2} {title}", style=style)
+        text.append(f"{mark} {index + 1:>2} {shown_line(title)}", style=style)
     return text
 
 

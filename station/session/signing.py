@@ -1,0 +1,202 @@
+"""Signing a session's ``finish`` with the station's own Ed25519 key.
+
+The hash chain finds any edit of a line, but someone who rewrites every later line (or appends,
+or cuts) and recomputes the hashes makes a chain that is intact again. A signature closes that
+for finished sessions: the ``finish`` event carries an Ed25519 signature over the session id,
+the ``prev`` hash (which covers every line before it) and its ``seq``, made with a key that only
+this station holds. The header names the key (``signer``: its id and public key), so
+``station verify`` checks the signature and prints the key id; a rechained or extended forgery
+cannot be re-signed without the private key. (A forger who also replaces the header's public
+key shows a different key id: compare it with the station's, ``station verify`` says whether it
+is this station's key.)
+
+The key is made on first use in ``$XDG_CONFIG_HOME/station/signing-key.pem`` (else
+``~/.config/station/``), PKCS#8, mode 0600, in a folder of mode 0700, never through a link.
+"""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import hashlib
+import os
+import stat
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from station.errors import StationError
+
+KEY_FILE_NAME = "signing-key.pem"
+SIGNATURE_CONTEXT = b"station-finish/1"
+
+
+def config_folder() -> Path:
+    """``$XDG_CONFIG_HOME/station`` (``~/.config/station`` when the variable is unset)."""
+    base = os.environ.get("XDG_CONFIG_HOME") or str(Path.home() / ".config")
+    return Path(base) / "station"
+
+
+def key_id(public_key: bytes) -> str:
+    """A key's short name: the first 16 hex digits of the sha256 of its 32 raw bytes."""
+    return hashlib.sha256(public_key).hexdigest()[:16]
+
+
+@dataclass(frozen=True)
+class StationKey:
+    """The station's signing key, loaded."""
+
+    private: Any  # cryptography's Ed25519PrivateKey
+    public_key: bytes
+    """The raw 32-byte public key."""
+
+    @property
+    def id(self) -> str:
+        """The key id printed by ``station verify``."""
+        return key_id(self.public_key)
+
+    def header_field(self) -> dict[str, str]:
+        """What goes into a session header's ``signer``."""
+        return {
+            "key": self.id,
+            "algorithm": "ed25519",
+            "public_key": base64.b64encode(self.public_key).decode("ascii"),
+        }
+
+    def sign(self, message: bytes) -> str:
+        """The base64 Ed25519 signature of ``message``."""
+        return base64.b64encode(self.private.sign(message)).decode("ascii")
+
+
+def finish_message(session_id: str, prev: str, seq: int) -> bytes:
+    """The bytes a finish event's signature covers: context, session id, ``prev``, ``seq``."""
+    return b"\0".join(
+        (SIGNATURE_CONTEXT, session_id.encode("utf-8"), prev.encode("ascii"), str(seq).encode())
+    )
+
+
+def station_key(create: bool = True) -> StationKey | None:
+    """The station's key, made on first use when ``create`` (None when it does not exist and
+    ``create`` is False). StationError when the key file cannot be read or made."""
+    from cryptography.hazmat.primitives import serialization
+    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
+
+    path = config_folder() / KEY_FILE_NAME
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except FileNotFoundError:
+        if not create:
+            return None
+        return _make_key(path)
+    except OSError as error:
+        raise StationError(
+            f"cannot read the station's signing key {path}: {error.strerror}"
+        ) from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode) or info.st_size > 4096:
+            raise StationError(f"the station's signing key {path} is not a key file; move it away")
+        data = os.read(fd, 4096)
+    finally:
+        os.close(fd)
+    try:
+        private = serialization.load_pem_private_key(data, password=None)
+    except (ValueError, TypeError):
+        raise StationError(
+            f"the station's signing key {path} is damaged; move it away (a new key is made)"
+        ) from None
+    if not isinstance(private, Ed25519PrivateKey):
+        raise StationError(f"the station's signing key {path} is not an Ed25519 key")
+    return StationKey(private, _raw_public(private))
+
+
+def _make_key(path: Path) -> StationKey:
+    from cryptography.hazmat.primitives import serialization
+    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
+
+    private = Ed25519PrivateKey.generate()
+    pem = private.private_bytes(
+        serialization.Encoding.PEM,
+        serialization.PrivateFormat.PKCS8,
+        serialization.NoEncryption(),
+    )
+    try:
+        path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o600)
+    except FileExistsError:
+        # Another process made it first: use that one.
+        key = station_key(create=False)
+        assert key is not None
+        return key
+    except OSError as error:
+        raise StationError(
+            f"cannot make the station's signing key in {path.parent}: {error.strerror}"
+        ) from None
+    try:
+        os.fchmod(fd, 0o600)
+        os.write(fd, pem)
+        os.fsync(fd)
+    except OSError as error:
+        os.close(fd)
+        with contextlib.suppress(OSError):
+            path.unlink()
+        raise StationError(
+            f"cannot write the station's signing key {path}: {error.strerror}"
+        ) from None
+    os.close(fd)
+    return StationKey(private, _raw_public(private))
+
+
+def _raw_public(private: Any) -> bytes:
+    from cryptography.hazmat.primitives import serialization
+
+    return private.public_key().public_bytes(
+        serialization.Encoding.Raw, serialization.PublicFormat.Raw
+    )
+
+
+@dataclass(frozen=True)
+class SignatureCheck:
+    """What ``station verify`` says about a finish signature."""
+
+    ok: bool
+    key: str
+    """The key id the header names ('' for a session made before signing)."""
+    message: str
+
+
+def check_finish_signature(header: Mapping[str, Any], finish: Mapping[str, Any]) -> SignatureCheck:
+    """Check ``finish`` (a finish event as stored, with its ``prev`` and ``seq``) against the
+    header's ``signer``. A header without ``signer`` (a session made before signing) is ok
+    with a message saying the finish is unsigned."""
+    from cryptography.exceptions import InvalidSignature
+    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PublicKey
+
+    signer = header.get("signer")
+    if signer is None:
+        return SignatureCheck(True, "", "unsigned (the session predates signing)")
+    try:
+        public = base64.b64decode(str(signer["public_key"]), validate=True)
+        named = str(signer["key"])
+        public_key = Ed25519PublicKey.from_public_bytes(public)
+    except (KeyError, TypeError, ValueError):
+        return SignatureCheck(False, "", "the header's signer is not an Ed25519 public key")
+    if key_id(public) != named:
+        return SignatureCheck(False, named, "the header's key id does not match its public key")
+    signature = finish.get("signature")
+    if not isinstance(signature, str):
+        return SignatureCheck(False, named, "the finish event is not signed")
+    try:
+        public_key.verify(
+            base64.b64decode(signature, validate=True),
+            finish_message(str(header.get("session")), str(finish.get("prev")), finish["seq"]),
+        )
+    except (InvalidSignature, ValueError):
+        return SignatureCheck(
+            False,
+            named,
+            "the finish event's signature does not match (the file was rewritten without the "
+            "station's key)",
+        )
+    return SignatureCheck(True, named, f"finish signed by station key {named}")
