@@ -7,8 +7,6 @@ import json
 
 import numpy as np
 import pytest
-from station.runner import analysis_config
-from station.session.report import analyze_session_file
 
 from station.analysis.live import LiveMonitor, replay_live_alarms
 from station.errors import StationError
@@ -18,8 +16,10 @@ from station.session.alarms import (
     live_events,
     recorded_alarms,
 )
+from station.session.header import analysis_config
 from station.session.journal import SessionWriter
 from station.session.model import load_session
+from station.verdicts import analyze_session_file
 
 from .conftest import session_header_fields
 
