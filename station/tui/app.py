@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from textual import work
 from textual.app import App
 from textual.binding import Binding
 
@@ -103,12 +104,15 @@ class StationApp(App[int]):
         self._latest_state: RunnerState | None = None
         self._latest_analysis: Any = None
         self._latest_result: Any = None
+        self._finishing = False
         self._state_lock = threading.Lock()
         self._last_redraw = 0.0
         self._redraw_pending = False
         self._oldest_pending = 0.0
         self.redraw_hooks: list[Callable[[float], None]] = []
         """Called after each redraw with the oldest pending event's stamp (for the benchmark)."""
+        self.reading_hooks: list[Callable[[], None]] = []
+        """Called after a reading's line is painted (for the benchmark)."""
         self._signals_installed: list[int] = []
         self._warmed_up = False
         self.demo_fixture: Any = None
@@ -274,19 +278,37 @@ class StationApp(App[int]):
         self._show_runner_screen(self.runner.state())
 
     def finish_session(self) -> None:
-        """Close the cycles step when it has its minimum, write ``finish``, show the summary."""
+        """Write ``finish`` (the engine closes the current step where it has its minimum) and
+        show the summary. The write and the session's report run on a worker thread: the UI
+        never waits on the disk or the analysis."""
         runner = self.runner
-        if runner is None:
+        if runner is None or self._finishing:
             return
-        # The engine closes the current step where it has its minimum, then finishes.
-        analysis = runner.finish()
-        state = runner.state()
-        self.close_instruments()
-        from station.tui.screens.summary import SummaryScreen, SummaryView
+        self._finishing = True
+        self._finish_in_thread(runner)
 
-        self._replace_run_screen(
-            SummaryScreen(SummaryView.from_live(state, analysis, self.session_header))
-        )
+    @work(thread=True, group="finish", exit_on_error=False)
+    def _finish_in_thread(self, runner: Runner) -> None:
+        from station.tui.screens.summary import SummaryView
+
+        try:
+            analysis = runner.finish()
+            view = SummaryView.from_live(runner.state(), analysis, self.session_header)
+        except StationError as error:
+            self.call_from_thread(self._finish_refused, explained(error))
+            return
+        self.call_from_thread(self._show_summary, view)
+
+    def _finish_refused(self, sentence: str) -> None:
+        self._finishing = False
+        self.notify(sentence, severity="error", markup=False)
+
+    def _show_summary(self, view: Any) -> None:
+        from station.tui.screens.summary import SummaryScreen
+
+        self._finishing = False
+        self.close_instruments()
+        self._replace_run_screen(SummaryScreen(view))
 
     # ---------------------------------------------------------------------------------------
     # Runner -> screen
@@ -309,7 +331,11 @@ class StationApp(App[int]):
         self.post_message(RunnerChanged(event_type=event_type, posted_at=time.monotonic()))
 
     def on_runner_changed(self, message: RunnerChanged) -> None:
-        """Redraw now if the last redraw is old enough, else once when it is."""
+        """A reading on disk is painted at once as one cheap line (the counters and last
+        values); the whole screen is redrawn now if the last redraw is old enough, else once
+        when it is (at most ~10 a second, whatever the rate)."""
+        if message.event_type == "reading":
+            self._paint_last_reading()
         if not self._oldest_pending or message.posted_at < self._oldest_pending:
             self._oldest_pending = message.posted_at
         if self._redraw_pending:
@@ -320,6 +346,17 @@ class StationApp(App[int]):
         else:
             self._redraw_pending = True
             self.set_timer(wait, self.redraw_live)
+
+    def _paint_last_reading(self) -> None:
+        with self._state_lock:
+            state = self._latest_state
+        screen = self.screen
+        paint = getattr(screen, "show_last_reading", None)
+        if state is None or paint is None or not screen.is_mounted:
+            return
+        paint(state)
+        for hook in self.reading_hooks:
+            hook()
 
     def redraw_live(self) -> None:
         """Hand the newest runner state to the screen showing it; switch screens on step kind."""

@@ -185,3 +185,58 @@ def test_sigterm_mid_stream_then_resume_continues_the_strokes(tmp_path: Path) ->
     verify(path)
     document = analyze_json(path)
     assert len(document["linearity"]["strokes"]) == STROKES
+
+
+def test_a_site_copy_of_linearity_under_another_id_gets_the_linearity_report(
+    tmp_path: Path,
+) -> None:
+    """The report follows the procedure's ``analysis``, never its id: a site's own copy of
+    linearity.toml (id "bar-check") gets the linearity report from capture and analyze."""
+    from station.procedures import builtin_procedures_dir
+    from station.verdicts import analyze_session_file
+
+    folder = tmp_path / "site"
+    folder.mkdir()
+    text = (builtin_procedures_dir() / "linearity.toml").read_text()
+    text = re.sub(r'(?m)^id = "linearity"$', 'id = "bar-check"', text)
+    assert 'id = "bar-check"' in text
+    (folder / "bar-check.toml").write_text(text)
+    simulator, url = start_bar()
+    try:
+        process = subprocess.Popen(
+            [
+                *STATION,
+                "capture",
+                "--procedure",
+                "bar-check",
+                "--procedures",
+                str(folder),
+                "--port",
+                url,
+                "--protocol",
+                "mitutoyo",
+                "--robot",
+                "KSC-7",
+                "--trigger",
+                "push",
+                "--strokes",
+                "4",
+                "--sessions",
+                str(tmp_path / "sessions"),
+            ],  # fmt: skip
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        out, err = process.communicate(timeout=60)
+    finally:
+        stop(simulator)
+    assert process.returncode == 0, err
+    assert "LINEARITY REPORT" in out
+    path = next((tmp_path / "sessions").glob("*.jsonl"))
+    assert load_session(path).procedure_id == "bar-check"
+    document = analyze_json(path)
+    assert document["procedure"] == "linearity" and len(document["linearity"]["strokes"]) == 4
+    # The TUI's summary reads the same registry (its report block is this one).
+    report = analyze_session_file(path)
+    assert report.kind == "linearity" and report.sections

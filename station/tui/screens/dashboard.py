@@ -184,12 +184,19 @@ class DashboardScreen(Screen[None]):
         """Redraw from a runner snapshot and the live analysis (UI thread)."""
         self.draw(DashboardView.from_live(state, self.app.live_analysis(), self.app.session_header))
 
-    def draw(self, view: DashboardView) -> None:
-        """Put ``view`` on screen."""
+    def show_last_reading(self, state: RunnerState) -> None:
+        """A reading set is on disk: paint the counters, the prompt and the last values at
+        once (cheap text); the charts follow with the next coalesced redraw."""
+        if not self.live or not self.is_mounted:
+            return
+        view = DashboardView.from_live(state, self.app.live_analysis(), self.app.session_header)
+        self._draw_text(view)
+
+    def _draw_text(self, view: DashboardView) -> None:
+        """The title with the counters, the prompt and the statistics (the last values)."""
         self.view = view
         if view.channels and self.selected not in view.channels:
             self.selected = view.channels[0]
-        decimals = decimals_for(view.resolution)
         title = shown(view.title, style="bold", limit=200)
         title.append(f"   {view.progress}", style="bold cyan")
         self.query_one("#dash-title", Static).update(title)
@@ -201,11 +208,16 @@ class DashboardScreen(Screen[None]):
                 channels=view.channels,
                 analyses=view.analyses,
                 last=view.last,
-                decimals=decimals,
+                decimals=decimals_for(view.resolution),
                 unit=view.unit,
                 selected=self.selected,
             )
         )
+
+    def draw(self, view: DashboardView) -> None:
+        """Put ``view`` on screen."""
+        self._draw_text(view)
+        decimals = decimals_for(view.resolution)
         selected = view.analyses.get(self.selected)
         self.query_one(HistogramView).show(histogram_data(selected, decimals))
         self.query_one(ControlChartView).show(
