@@ -235,13 +235,13 @@ async def test_gain_schedule_through_the_tui(tmp_path: Path, tui) -> None:
     app = StationApp(StationConfig(sessions_dir=tmp_path, sessions_reason="test folder"))
 
     def gains(step) -> dict[str, str]:
-        q = -30 + 18.75 * (step.placement - 1)
+        q = -30 + 30 * (step.placement - 1)
         kp = 2 - 0.03 * q + 4e-4 * q**2 - 1e-6 * q**3
         return {"q": f"{q:g}", "kp": f"{kp:.9f}", "ki": f"{0.4 + 0.001 * q:.6f}", "kd": "0.07"}
 
     try:
         async with app.run_test(size=(80, 24)) as pilot:
-            await set_up(pilot, tui, "gain_schedule", url, "1=q", "9")
+            await set_up(pilot, tui, "gain_schedule", url, "1=q", "6")
             path = await walk(pilot, tui, gains)
     finally:
         simulator.stop()
