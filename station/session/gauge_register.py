@@ -353,3 +353,19 @@ def verdict_lines(
         return coverage_lines(coverage(gauges, today, path=path, valid_days=valid_days))
     except StationError as error:
         return [f"WARNING: the gauge register cannot be read ({error.message})"]
+
+
+def all_covered(statuses: Mapping[str, GaugeStatus | Mapping[str, Any]]) -> bool:
+    """True when every channel's gauge has a passed, current check (and there is at least one):
+    the condition for a verdict that rests on checked gauges."""
+    if not statuses:
+        return False
+    return all(
+        (s.state if isinstance(s, GaugeStatus) else s.get("state")) == "passed"
+        for s in statuses.values()
+    )
+
+
+def register_rows(register: Mapping[str, Any], today: dt.date) -> list[GaugeStatus]:
+    """Every gauge in a loaded register with its status on ``today``, by id."""
+    return [gauge_status(register, gauge, today) for gauge in sorted(register.get("gauges", {}))]

@@ -18,7 +18,6 @@ from station.session.method_reports import (
     gauge_check_from_session,
     joints_from_session,
     method_count,
-    record_gauge_check,
 )
 from station.session.model import load_session
 
@@ -62,6 +61,10 @@ def capture(url: str, folder: Path, procedure: str, *extra: str, protocol: str =
     )
     assert done.returncode == 0, done.stderr
     return next(folder.glob("*.jsonl"))
+
+
+def gauges(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([*STATION, "gauges", *args], capture_output=True, text=True, timeout=60)
 
 
 def analyze_json(path: Path) -> dict:
@@ -117,13 +120,20 @@ def test_gauge_check_session_is_analysed_and_filed(
     # 0.0001 in step) is in every later reading, so the bias is known to about one step.
     assert study["bias"] == pytest.approx(bias, abs=0.00003 if protocol == "idh" else 0.00015)
     session = load_session(path)
+    assert method_count("gauge_check", gauge_check_from_session(session)) == "25 readings"
+    # Filed in the register by `station gauges record`, then asked for by `station gauges status`.
     register = tmp_path / "gauges.json"
-    record_gauge_check(session, gauge_check_from_session(session), register=register)
+    recorded = gauges("record", str(path), "--register", str(register))
+    assert recorded.returncode == 0, recorded.stderr
+    assert f"gauge check {'passed' if capable else 'failed'} on {session.created[:10]}" in (
+        recorded.stdout
+    )
     status = coverage({"x": "MIT-0042"}, dt.date.fromisoformat(session.created[:10]), path=register)
     assert status["x"].state == ("passed" if capable else "failed")
-    line = coverage_lines(status)[0]
-    assert ("gauge check passed on" in line) is capable
-    assert method_count("gauge_check", gauge_check_from_session(session)) == "25 readings"
+    asked = gauges("status", "MIT-0042", "--register", str(register))
+    assert asked.returncode == (0 if capable else 1)
+    assert ("gauge MIT-0042: gauge check passed on" in asked.stdout) is capable
+    assert coverage_lines(status)[0].startswith("x: ")
 
 
 @pytest.mark.parametrize("protocol", ["idh", "mitutoyo"])
@@ -198,3 +208,21 @@ def test_gain_schedule_session_from_typed_gains(tmp_path: Path):
     )
     assert document["gains"]["kd"]["order"] == 0
     assert len(document["positions"]) == 9
+
+
+def test_gauges_record_refuses_another_kind_of_session(tmp_path: Path):
+    from datetime import UTC, datetime
+
+    from station.session.journal import SessionWriter
+    from tests.session.conftest import session_header_fields
+
+    with SessionWriter.create(
+        tmp_path, session_header_fields(), now=datetime(2026, 11, 23, tzinfo=UTC)
+    ) as writer:
+        path = writer.path
+    result = gauges("record", str(path), "--register", str(tmp_path / "g.json"))
+    assert result.returncode == 2
+    assert "is a repeatability session, not a gauge check" in result.stderr
+    assert not (tmp_path / "g.json").exists()
+    listed = gauges("list", "--register", str(tmp_path / "g.json"))
+    assert listed.returncode == 0 and "no gauges recorded yet" in listed.stdout
