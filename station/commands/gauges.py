@@ -92,7 +92,7 @@ def run_record(args: argparse.Namespace) -> int:
     """Analyse a gauge_check session and file its study under the gauge id typed in it."""
     from station.session.method_reports import gauge_check_from_session, record_gauge_check
     from station.session.model import load_session
-    from station.session.report import session_analysis
+    from station.verdicts import session_analysis
 
     session = load_session(Path(args.session), recover=False)
     kind = session_analysis(session)
