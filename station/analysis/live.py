@@ -543,7 +543,7 @@ class LiveChannel:
                 center=update.center,
                 ucl=update.ucl,
                 lcl=update.lcl if update.lcl is not None else update.center,
-                source=f"first {len(self._points)} points",
+                source=f"frozen after the first {len(self._points)} points",
             )
             return self._catch_up()
         return self._newest_frozen_alarms()

@@ -33,7 +33,7 @@ DEFAULT_FREEZE_AFTER = 20
 class FrozenLimits:
     """Phase II control limits of one channel's location chart: centre line, UCL and LCL of the
     plotted points (individuals or subgroup means), and where they came from (``source``:
-    "first 20 points", "baseline of robot R7 ..."). They never move once set."""
+    "frozen after the first 20 points", "baseline of robot R7 ..."). They never move once set."""
 
     center: float
     ucl: float
