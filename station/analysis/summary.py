@@ -309,7 +309,7 @@ def frozen_limits_of(name: str, values: np.ndarray, config: AnalysisConfig) -> F
     """The phase II limits the live analysis froze (or the baseline's): the chart of the first
     ``freeze_after`` points, or of the first points after that whose chart has a spread."""
     if config.baseline is not None and name in config.baseline.limits:
-        return config.baseline.limits[name]
+        return config.baseline.limits_for(name)
     k = config.freeze_after
     size = config.subgroup
     points = len(values) // size
