@@ -25,7 +25,7 @@ from collections.abc import Sequence
 
 from station.analysis.capability import Capability, SpecLimits
 from station.analysis.descriptive import Descriptive
-from station.analysis.rules import Alarm, number_list
+from station.analysis.rules import Alarm, number_list, rule_name
 
 #: |a₁| at or above this is "close to 1 or higher" (report §2.7.1).
 SKEW_HINT = 0.8
@@ -103,7 +103,7 @@ def channel_hints(
             "has shifted off nominal; re-centre it (re-teach or compensate the offset)."
         )
     if alarms:
-        fired = "; ".join(f"{alarm.rule} at {_where(alarm)}" for alarm in alarms[:6])
+        fired = "; ".join(f"{rule_name(alarm.rule)} at {_where(alarm)}" for alarm in alarms[:6])
         more = f"; and {len(alarms) - 6} more" if len(alarms) > 6 else ""
         hints.append(
             f"{name}: the control chart shows a pattern ({fired}{more}); look at those cycles "

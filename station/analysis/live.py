@@ -543,7 +543,7 @@ class LiveChannel:
                 center=update.center,
                 ucl=update.ucl,
                 lcl=update.lcl if update.lcl is not None else update.center,
-                source=f"first {len(self._points)} points",
+                source=f"frozen after the first {len(self._points)} points",
             )
             return self._catch_up()
         return self._newest_frozen_alarms()
@@ -657,7 +657,7 @@ class LiveAnalysis:
         """The live channel ``name``, created on first use (with the baseline's limits for it,
         else freezing after ``freeze_after`` points, else with moving limits)."""
         if name not in self.channels:
-            fixed = None if self.baseline is None else self.baseline.limits.get(name)
+            fixed = None if self.baseline is None else self.baseline.limits_for(name)
             self.channels[name] = LiveChannel(
                 name, self.config, freeze_after=self.freeze_after, baseline=fixed
             )

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 from station.analysis.constants import SIGMA_MULTIPLE
@@ -33,7 +33,7 @@ DEFAULT_FREEZE_AFTER = 20
 class FrozenLimits:
     """Phase II control limits of one channel's location chart: centre line, UCL and LCL of the
     plotted points (individuals or subgroup means), and where they came from (``source``:
-    "first 20 points", "baseline of robot R7 ..."). They never move once set."""
+    "frozen after the first 20 points", "baseline of robot R7 ..."). They never move once set."""
 
     center: float
     ucl: float
@@ -69,6 +69,13 @@ class ControlBaseline:
     limits: Mapping[str, FrozenLimits] = field(default_factory=dict)
     source: str = ""
     """Where the baseline comes from, for the session header and the report."""
+
+    def limits_for(self, channel: str) -> FrozenLimits | None:
+        """The channel's limits, naming the baseline's source when they name none."""
+        found = self.limits.get(channel)
+        if found is None or found.source or not self.source:
+            return found
+        return replace(found, source=self.source)
 
 
 @dataclass(frozen=True)

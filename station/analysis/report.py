@@ -336,8 +336,11 @@ def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int 
         lines.append(f"ALARMS (rules: {config.rule_set}): none")
     frozen = channel.frozen
     if frozen is not None:
+        source = frozen.source
+        if not source.startswith("frozen"):
+            source = f"baseline: {source}" if source else "baseline"
         lines += _wrap(
-            f"LIVE LIMITS (phase II, frozen from the {frozen.source or 'baseline'}): "
+            f"LIVE LIMITS (phase II, {source}): "
             f"UCL {signed(frozen.ucl, decimals)}   CENTER {signed(frozen.center, decimals)}   "
             f"LCL {signed(frozen.lcl, decimals)}",
             width,

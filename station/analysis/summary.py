@@ -309,7 +309,7 @@ def frozen_limits_of(name: str, values: np.ndarray, config: AnalysisConfig) -> F
     """The phase II limits the live analysis froze (or the baseline's): the chart of the first
     ``freeze_after`` points, or of the first points after that whose chart has a spread."""
     if config.baseline is not None and name in config.baseline.limits:
-        return config.baseline.limits[name]
+        return config.baseline.limits_for(name)
     k = config.freeze_after
     size = config.subgroup
     points = len(values) // size
@@ -334,7 +334,7 @@ def frozen_limits_of(name: str, values: np.ndarray, config: AnalysisConfig) -> F
         first, k = chart_of(high), high
     assert first.center is not None and first.ucl is not None
     lcl = first.lcl if first.lcl is not None else first.center
-    return FrozenLimits(first.center, first.ucl, lcl, f"first {k} points")
+    return FrozenLimits(first.center, first.ucl, lcl, f"frozen after the first {k} points")
 
 
 def analyze_channel(
@@ -719,6 +719,9 @@ def to_json(analysis: Analysis) -> dict[str, Any]:
         "rules": config.rule_set,
         "threshold": _number(config.threshold),
         "excluded_cycles": list(analysis.excluded_cycles),
+        "min_n": config.min_n,
+        "freeze_after": config.freeze_after,
+        "baseline": None if config.baseline is None else config.baseline.source or "baseline",
         "channels": {name: channel_to_json(c) for name, c in analysis.channels.items()},
         "spatial": None if analysis.spatial is None else spatial_to_json(analysis.spatial),
         "hints": list(analysis.hints),

@@ -58,7 +58,7 @@ def test_a_rule_alarm_asks_to_look_at_the_pattern():
     values = noise()
     values[20] = 0.0009
     (hint,) = [h for h in hints(values) if "pattern" in h]
-    assert "report-1 at cycle 21" in hint
+    assert "report rule 1 (a point beyond the control limits) at cycle 21" in hint
 
 
 def test_a_tolerance_under_ten_gauge_steps_means_the_gauge_is_too_coarse():

@@ -17,6 +17,7 @@ from station.analysis.live import (
     replay_live_alarms,
 )
 from station.analysis.phases import baseline_from_json, baseline_to_json
+from station.analysis.report import format_report
 from station.analysis.summary import AnalysisConfig, analyze, analyze_channel, to_json
 from station.errors import StationError
 
@@ -78,7 +79,7 @@ def test_live_alarms_equal_the_batch_live_alarms_and_name_cycles():
     # Each retrospective alarm is marked live or not; the JSON says which.
     document = to_json(analyze({"x": values}, CONFIG))["channels"]["x"]
     assert {a["live"] for a in document["alarms"]} <= {True, False}
-    assert document["phase_two"]["source"] == "first 20 points"
+    assert document["phase_two"]["source"] == "frozen after the first 20 points"
     assert document["live_alarms"] and all(a["live"] for a in document["live_alarms"])
 
 
@@ -106,9 +107,23 @@ def test_a_baseline_judges_from_the_first_reading():
     )
     config = AnalysisConfig(default_limits=CONFIG.default_limits, baseline=baseline)
     assert analyze_channel("x", [0.0005], config).live_alarms[0].rule == "report-1"
+    text = format_report(analyze({"x": np.array([0.0005, 0.0, 0.0001])}, config))
+    assert "LIVE LIMITS (phase II, baseline: robot R7, 2026-11): UCL +0.00030" in text
     assert baseline_from_json(baseline_to_json(baseline)) == ControlBaseline(
         {"x": FrozenLimits(0.0, 0.0003, -0.0003, "robot R7, 2026-11")}, "robot R7, 2026-11"
     )
+
+
+def test_subgroup_means_are_judged_live_as_in_batch():
+    config = AnalysisConfig(default_limits=CONFIG.default_limits, subgroup=5)
+    values = drifting_with_outliers(n=200, seed=7)
+    monitor = LiveMonitor(config, ["x"], freeze_after=20)
+    seen = []
+    for cycle, value in enumerate(values, start=1):
+        seen += monitor.add_set({"x": float(value)}, cycle)[0]["x"].alarms
+    batch = analyze_channel("x", values, config)
+    assert seen and flags(seen) == flags(batch.live_alarms)
+    assert batch.frozen.source == "frozen after the first 20 points"
 
 
 def test_a_reading_beyond_a_limit_is_flagged_at_once():

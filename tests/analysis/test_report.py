@@ -105,7 +105,9 @@ def test_incapable_alarms_3d_and_hints_are_reported():
     assert "ISO 9283 pose repeatability RP = l-bar + 3 S_l:" in text
     hints = " ".join(text.split("HINTS", 1)[1].split())
     assert "- x: the control chart shows a pattern (" in hints
-    assert "nelson-1 at cycle 26" in hints
+    assert "Nelson rule 1 (a point beyond the control limits) at cycle 26" in " ".join(
+        hints.split()
+    )
     assert_fits(text, 80)
 
 

@@ -253,7 +253,10 @@ def test_pieces_and_alarms_are_named_by_cycle_number(tmp_path):
     (alarm,) = [a for a in x["alarms"] if a["rule"] == "report-1"]
     assert alarm["points"] == [6] and alarm["cycles"] == [7]
     assert alarm["text"].startswith("Cycle 7 is above the upper control limit")
-    assert any("report-1 at cycle 7;" in hint for hint in document["hints"])
+    assert any(
+        "report rule 1 (a point beyond the control limits) at cycle 7;" in hint
+        for hint in document["hints"]
+    )
 
     text = station(path).stdout
     pieces = _pieces(text)

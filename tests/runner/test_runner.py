@@ -50,6 +50,7 @@ def batch_analysis(path: Path):
         analysis_config(session.header),
         excluded_cycles=session.excluded_cycles,
         cycles=session.channel_cycles(),
+        times=session.channel_times(),
     )
 
 
