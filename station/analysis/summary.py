@@ -354,7 +354,7 @@ def _number(value: float | None) -> float | None:
 def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
     """One channel of the JSON document."""
     d, cap, chart = channel.descriptive, channel.capability, channel.chart
-    return {
+    document = {
         "n": d.n,
         "mean": _number(d.mean),
         "sd": _number(d.sd),
@@ -364,7 +364,9 @@ def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
         "max": _number(d.max),
         "range": _number(d.range),
         "nominal": _number(channel.nominal),
-        "cycles": list(channel.cycles),
+        # Absent when the readings are cycles 1 to n in order (a million-row CSV would
+        # otherwise print a million numbers that say nothing).
+        **({} if _numbered_in_order(channel.cycles) else {"cycles": list(channel.cycles)}),
         "capability": {
             "lsl": _number(cap.lsl),
             "usl": _number(cap.usl),
@@ -402,6 +404,7 @@ def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
             for a in channel.alarms
         ],
     }
+    return document
 
 
 def spatial_to_json(spatial: Spatial) -> dict[str, Any]:
@@ -436,3 +439,11 @@ def to_json(analysis: Analysis) -> dict[str, Any]:
         "spatial": None if analysis.spatial is None else spatial_to_json(analysis.spatial),
         "hints": list(analysis.hints),
     }
+
+
+def _numbered_in_order(cycles: Any) -> bool:
+    """True when ``cycles`` is exactly 1, 2, ..., n."""
+    import numpy as np
+
+    numbers = np.asarray(cycles)
+    return bool(numbers.size == 0 or np.array_equal(numbers, np.arange(1, numbers.size + 1)))
