@@ -150,7 +150,11 @@ def is_session_file(path: Path) -> bool:
 def load_source(path: Path) -> Any:
     """A session file (detected by its header: a ``SessionSource``) or a CSV table of readings
     (a ``TableSource``)."""
-    if path.is_file() and is_session_file(path):
+    from station.inputfiles import check_regular_file
+
+    # A FIFO, a device, a folder or a name too long is refused before a byte is read.
+    check_regular_file(path, "file of readings")
+    if is_session_file(path):
         from station.session.report import load_session_source
 
         return load_session_source(path)
