@@ -57,12 +57,16 @@ def _range_moments(n: int) -> tuple[float, float]:
 
 def d2(n: int) -> float:
     """Expected range of ``n`` >= 2 independent standard normal values (d2(2) = 2/sqrt(pi))."""
-    return _range_moments(_check_size(n, 2))[0]
+    if _check_size(n, 2) == 2:
+        return 2.0 / math.sqrt(math.pi)  # closed form: the I-MR chart needs no quadrature
+    return _range_moments(n)[0]
 
 
 def d3(n: int) -> float:
     """Standard deviation of the range of ``n`` >= 2 independent standard normal values."""
-    return _range_moments(_check_size(n, 2))[1]
+    if _check_size(n, 2) == 2:
+        return math.sqrt(2.0 - 4.0 / math.pi)  # |X1 - X2| with X1 - X2 ~ N(0, 2)
+    return _range_moments(n)[1]
 
 
 @cache

@@ -538,7 +538,9 @@ def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
         "max": _number(d.max),
         "range": _number(d.range),
         "nominal": _number(channel.nominal),
-        "cycles": list(channel.cycles),
+        # Absent when the readings are cycles 1 to n in order (a million-row CSV would
+        # otherwise print a million numbers that say nothing).
+        **({} if _numbered_in_order(channel.cycles) else {"cycles": list(channel.cycles)}),
         "capability": {
             "lsl": _number(cap.lsl),
             "usl": _number(cap.usl),
@@ -689,6 +691,7 @@ def _drift_json(result: Drift | None) -> dict[str, Any] | None:
         },
         "message": result.message,
     }
+    return document
 
 
 def spatial_to_json(spatial: Spatial) -> dict[str, Any]:
@@ -726,3 +729,11 @@ def to_json(analysis: Analysis) -> dict[str, Any]:
         "spatial": None if analysis.spatial is None else spatial_to_json(analysis.spatial),
         "hints": list(analysis.hints),
     }
+
+
+def _numbered_in_order(cycles: Any) -> bool:
+    """True when ``cycles`` is exactly 1, 2, ..., n."""
+    import numpy as np
+
+    numbers = np.asarray(cycles)
+    return bool(numbers.size == 0 or np.array_equal(numbers, np.arange(1, numbers.size + 1)))

@@ -166,7 +166,11 @@ def is_session_file(path: Path) -> bool:
 def load_source(path: Path) -> Any:
     """A session file (detected by its header: a ``SessionSource``) or a CSV table of readings
     (a ``TableSource``)."""
-    if path.is_file() and is_session_file(path):
+    from station.inputfiles import check_regular_file
+
+    # A FIFO, a device, a folder or a name too long is refused before a byte is read.
+    check_regular_file(path, "file of readings")
+    if is_session_file(path):
         from station.verdicts import load_session_source
 
         return load_session_source(path)
@@ -311,7 +315,10 @@ def run(args: argparse.Namespace) -> int:
         raise StationError(f"{path}: the session has no accepted readings to analyse yet.")
 
     if args.json:
-        print(json.dumps(report.document(), indent=2, allow_nan=False))
+        # Indented for a person at a terminal; compact (json's C encoder, several times faster
+        # on a document of thousands of alarms) when a script reads it.
+        indent = 2 if sys.stdout.isatty() else None
+        print(json.dumps(report.document(), indent=indent, allow_nan=False))
     else:
         print(
             format_report(

@@ -648,6 +648,7 @@ def run(args: argparse.Namespace) -> int:
         }
     else:
         setup, done = _setup(args), set()
+        sessions_folder(args.sessions)  # an empty --sessions is refused before any gauge opens
     from station.run import plan_steps
 
     _check_answerable(plan_steps(setup), setup.procedure, inputs, done)

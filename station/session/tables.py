@@ -75,7 +75,7 @@ CSV_FILE_LIMIT = 8 << 30
 """The largest CSV file read (8 GiB, some 500 million one-column rows)."""
 HEADER_LINE_LIMIT = 1 << 20
 
-_NUMBER = re.compile(r"^\s*[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\s*$")
+_NUMBER = re.compile(r"^\s*[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\s*$", re.ASCII)
 _NAMED_NUMBER = re.compile(r"^\s*[+-]?(?:inf|infinity|nan)\s*$", re.IGNORECASE)
 
 
