@@ -691,7 +691,6 @@ def _drift_json(result: Drift | None) -> dict[str, Any] | None:
         },
         "message": result.message,
     }
-    return document
 
 
 def spatial_to_json(spatial: Spatial) -> dict[str, Any]:
