@@ -650,9 +650,9 @@ def _analysis_kind(
     if needs.facet and not any(getattr(schema, needs.facet) for schema in schemas):
         raise check.fail("", f"'analysis' {declared} needs {needs.facet_words}")
     if not set(needs.channels) <= set(channels):
-        raise check.fail(
-            "", f"'analysis' {declared} needs the channels {', '.join(needs.channels)}"
-        )
+        names = list(needs.channels)
+        listed = ", ".join(names[:-1]) + f" and {names[-1]}" if len(names) > 1 else names[0]
+        raise check.fail("", f"'analysis' {declared} needs the channels {listed}")
     _check_method_kind(check, declared, steps, channels)
     return str(declared)
 

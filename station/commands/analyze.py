@@ -106,6 +106,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="readings needed for a final verdict; below it the verdict is PROVISIONAL "
         "(default: the session's procedure minimum, else 25)",
     )
+    parser.add_argument(
+        "--freeze-after",
+        metavar="K",
+        help="phase I: the live control limits freeze after the first K readings (default: "
+        "the session's, else 20)",
+    )
     parser.add_argument("--unit", default="", help="unit of the readings, for the report")
     parser.add_argument(
         "--procedure",
@@ -201,6 +207,14 @@ class TableSource:
     analysis: str | None = None
 
 
+def table_times(table: Any) -> dict[str, Any] | None:
+    """The time of each channel's readings when the table dates its rows (a ``t`` column, a
+    tidy table's ``time``), for the drift's trend; None otherwise."""
+    if table.times is None or any(len(v) != len(table.times) for v in table.channels.values()):
+        return None
+    return {name: table.times for name in table.channels}
+
+
 def table_linearity_profiles(table: Any) -> list[Any]:
     """The strokes of a linearity CSV (columns stroke, s, h, v)."""
     from station.analysis.linearity import profiles_from_table
@@ -279,6 +293,9 @@ def run(args: argparse.Namespace) -> int:
         threshold=recorded.threshold if threshold is None else threshold,
         min_n=recorded.min_n if min_n is None else min_n,
     )
+    freeze_after = bounded_int(args.freeze_after, "--freeze-after", 2, SUBGROUP_LIMIT)
+    if freeze_after is not None:
+        config = replace(config, freeze_after=freeze_after)
     procedure = args.procedure or source.analysis or "repeatability"
     from station.session.method_reports import METHOD_KINDS
 
@@ -306,6 +323,7 @@ def run(args: argparse.Namespace) -> int:
             accuracy_inputs=lambda: table_accuracy_inputs(table),
             tolerance=tolerance,
             options={},
+            times=table_times(table),
         )
         report = judge(procedure, inputs, name=path.name)
     else:

@@ -20,7 +20,7 @@ import csv
 from typing import TextIO
 
 from station.session.export import export_csv, one_line
-from station.session.model import Session
+from station.session.model import Session, event_seconds
 
 LINEARITY_COLUMNS: tuple[str, ...] = ("stroke", "s", "h", "v")
 ACCURACY_COLUMNS: tuple[str, ...] = ("cycle", "placement", "x", "y", "z")
@@ -103,11 +103,14 @@ def export_table(session: Session, out: TextIO, layout: str = "tidy", kind: str 
         return export_accuracy_csv(session, out)
     _comments(session, out)
     writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(("cycle", *session.channels))
+    # ``t``: the cycle's time in seconds (the drift's trend reads it back).
+    writer.writerow(("cycle", "t", *session.channels))
     rows = 0
     for number in session.accepted_cycles:
-        readings = session.cycles[number].readings
+        cycle = session.cycles[number]
+        readings = cycle.readings
         if all(channel in readings for channel in session.channels):
-            writer.writerow((number, *(_number(readings[c].value) for c in session.channels)))
+            values = (_number(readings[c].value) for c in session.channels)
+            writer.writerow((number, repr(event_seconds(cycle.t)), *values))
             rows += 1
     return rows

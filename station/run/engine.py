@@ -35,6 +35,7 @@ journal's own sentence (:attr:`Runner.failure`).
 from __future__ import annotations
 
 import contextlib
+import math
 import queue
 import threading
 from collections import deque
@@ -66,7 +67,7 @@ from station.run.steps import handler_for
 from station.run.steps.base import PlanItem, StepHandler
 from station.session.header import analysis_config
 from station.session.journal import SessionWriter
-from station.session.model import Session
+from station.session.model import Session, event_seconds
 
 if TYPE_CHECKING:
     from station.instruments.gauge import CaptureResult, PortStatus, Subscription
@@ -271,7 +272,7 @@ class Runner:
                         placement=cycle.placement,
                         rejected=session.rejected.get(number),
                         resolution=self.setup.resolved_resolution,
-                        times=reading_times(cycle.readings),
+                        times=cycle_times(list(cycle.readings), {"t": cycle.t}),
                     )
                 )
             self._next_cycle = session.next_cycle
@@ -759,7 +760,7 @@ class Runner:
             step_id=item.step.id,
             placement=item.placement,
             resolution=self.setup.resolved_resolution,
-            times=reading_times(readings),
+            times=cycle_times(list(readings), self._last_event or {}),
         )
         self._cycles.append(record)
         self._accepted_by_step[item.key] = self._accepted_by_step.get(item.key, 0) + 1
@@ -931,13 +932,11 @@ class Runner:
             self._messages.append(OperatorMessage("error", f"the display failed: {error!r}"))
 
 
-def reading_times(readings: Mapping[str, Any]) -> dict[str, float] | None:
-    """Each channel's ``t_wall`` (the drift's trend runs on reading times), or None when a
-    reading has none (the trend then runs on cycle order, as the session file's analysis)."""
-    times = {channel: getattr(r, "t_wall", None) for channel, r in readings.items()}
-    if any(t is None for t in times.values()):
-        return None
-    return {channel: float(t) for channel, t in times.items()}
+def cycle_times(channels: Sequence[str], event: Mapping[str, Any]) -> dict[str, float] | None:
+    """The time of a cycle's readings for the drift's trend: its ``reading`` event's ``t``
+    (what the session file's analysis and its exports use), for every channel."""
+    stamp = event_seconds(str(event.get("t") or ""))
+    return None if math.isnan(stamp) else dict.fromkeys(channels, stamp)
 
 
 def set_problem(result: CaptureResult, needed: Sequence[str], unit: str) -> str:

@@ -342,17 +342,17 @@ class Session:
         }
 
     def channel_times(self, include_rejected: bool = False) -> dict[str, np.ndarray]:
-        """The time (seconds since the epoch) of each value :meth:`channel_values` gives: the
-        reading's ``t_wall`` when the gauge reader stamped it, else its event's time ``t``."""
+        """The time (seconds since the epoch) of each value :meth:`channel_values` gives: its
+        cycle's event time ``t`` (one time per cycle, the one an export carries, so a table
+        of the session dates its readings the same)."""
         import numpy as np
 
         numbers = sorted(self.cycles) if include_rejected else self.accepted_cycles
         times: dict[str, list[float]] = {channel: [] for channel in self.channels}
         for number in numbers:
             cycle = self.cycles[number]
-            fallback = _event_seconds(cycle.t)
-            for channel, reading in cycle.readings.items():
-                stamp = reading.t_wall if reading.t_wall is not None else fallback
+            stamp = event_seconds(cycle.t)
+            for channel in cycle.readings:
                 times.setdefault(channel, []).append(stamp)
         return {channel: np.asarray(column, dtype=float) for channel, column in times.items()}
 
@@ -369,7 +369,7 @@ class Session:
 # Replay: the one place that knows what a valid header and a valid event are
 
 
-def _event_seconds(stamp: str) -> float:
+def event_seconds(stamp: str) -> float:
     """An event's ISO-8601 UTC time ``t`` as seconds since the epoch (NaN when unreadable)."""
     from datetime import datetime
 

@@ -24,6 +24,7 @@ import numpy as np
 from station.errors import StationError
 from station.inputfiles import check_regular_file
 from station.plain import plain
+from station.session.model import event_seconds
 
 #: Column names (compared case-insensitively) that index the rows instead of holding readings.
 INDEX_COLUMNS: frozenset[str] = frozenset({"cycle", "subgroup", "t"})
@@ -49,6 +50,9 @@ class ReadingTable:
     """A tidy table's cycle numbers per channel (its channels may cover different cycles)."""
     excluded_cycles: tuple[int, ...] = ()
     """A tidy table's rejected cycles (status ``rejected: ...``), left out of the channels."""
+    times: np.ndarray | None = None
+    """The time (seconds) of each row, from a ``t`` column (or a tidy table's ``time``), for
+    the drift's trend; None without one."""
     placements: np.ndarray | None = None
     """A tidy table's fixture placement of each accepted cycle (aligned with the channels),
     None when it records none."""
@@ -187,6 +191,10 @@ def read_table(path: str | Path) -> ReadingTable:
         comments=tuple(comments),
         cycles=cycles,
         excluded_cycles=excluded_in_comments(comments),
+        times=next(
+            (np.ascontiguousarray(data[:, i]) for i, n in enumerate(names) if n.lower() == "t"),
+            None,
+        ),
     )
 
 
@@ -215,6 +223,7 @@ def _read_tidy(
     values: dict[str, list[float]] = {}
     cycles: dict[str, list[int]] = {}
     placement_of: dict[int, int] = {}
+    time_of: dict[int, float] = {}
     excluded: set[int] = set()
     for line_number, cells in data_rows:
         if len(cells) != len(names):
@@ -241,12 +250,17 @@ def _read_tidy(
         if cell.get("placement", "").strip():
             placement = _parse_cell(cell["placement"], path, line_number, "placement")
             placement_of[int(number)] = int(placement)
+        if cell.get("time", "").strip():
+            time_of[int(number)] = event_seconds(cell["time"].strip())
     if not values:
         raise StationError(f"{path}: every reading in the table is rejected; nothing to analyse.")
     first = next(iter(cycles.values()))
     placements = None
     if placement_of and all(c in placement_of for c in first):
         placements = np.asarray([placement_of[c] for c in first], dtype=float)
+    times = None
+    if time_of and all(c in time_of for c in first):
+        times = np.asarray([time_of[c] for c in first], dtype=float)
     return ReadingTable(
         path=path,
         channels={name: np.asarray(column, dtype=float) for name, column in values.items()},
@@ -256,6 +270,7 @@ def _read_tidy(
         channel_cycles={name: np.asarray(column, dtype=int) for name, column in cycles.items()},
         excluded_cycles=tuple(sorted(excluded - {c for cs in cycles.values() for c in cs})),
         placements=placements,
+        times=times,
     )
 
 
