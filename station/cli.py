@@ -105,14 +105,14 @@ def _main(argv: Sequence[str] | None) -> int:
 def _run(parser: argparse.ArgumentParser, arguments: list[str]) -> int:
     import errno
 
-    from station.commands._remedies import CLI_REMEDIES
+    from station.commands._remedies import cli_sentence
     from station.errors import StationError
 
     args = parser.parse_args(arguments)
     try:
         return int(args.func(args) or 0)
     except StationError as error:
-        print(f"station: {error.worded(CLI_REMEDIES)}", file=sys.stderr)
+        print(f"station: {cli_sentence(error)}", file=sys.stderr)
         return error.exit_code
     except KeyboardInterrupt:
         print("station: interrupted", file=sys.stderr)

@@ -55,16 +55,6 @@ def index(value: float | None) -> str:
     return "undefined" if value is None else f"{value:.2f}"
 
 
-def verdict_word(capability: Capability) -> str:
-    """CAPABLE, NOT CAPABLE or UNDEFINED: the verdict is always a word, never only a colour.
-
-    It ignores the minimum count: :func:`station.analysis.verdict.judge_verdict` gives the word
-    with PROVISIONAL below it (what the reports print)."""
-    if capability.capable is None:
-        return "UNDEFINED"
-    return "CAPABLE" if capability.capable else "NOT CAPABLE"
-
-
 def _pairs(items: Sequence[tuple[str, str]], width: int) -> list[str]:
     """Lay "LABEL: value" items out in rows of three like the report's header block, each
     column as wide as its widest cell; one per line when three do not fit."""

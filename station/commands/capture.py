@@ -258,6 +258,7 @@ def _setup(args: argparse.Namespace) -> Any:
     from station.analysis.capability import SpecLimits
     from station.commands.analyze import parse_limit
     from station.procedures import discover_procedures
+    from station.record.baseline import header_baseline
     from station.run import PortSetup, SessionSetup
 
     missing = [
@@ -300,13 +301,15 @@ def _setup(args: argparse.Namespace) -> Any:
         cycles=_positive(args.cycles, "--cycles", int) if args.cycles else None,
         placements=_positive(args.placements, "--placements", int) if args.placements else None,
         strokes=_positive(args.strokes, "--strokes", int) if args.strokes else None,
+        # Live alarms test against the robot's baseline when it has one for this procedure.
+        baseline=header_baseline(args.robot, procedure.id, args.unit or procedure.unit),
     )
 
 
 def _channel_map(args: argparse.Namespace, channels: tuple[str, ...]) -> dict[str, str]:
-    from station.commands.read import parse_map
+    from station.text import parse_channel_map
 
-    return parse_map(args.map) or {str(i): ch for i, ch in enumerate(channels, start=1)}
+    return parse_channel_map(args.map) or {str(i): ch for i, ch in enumerate(channels, start=1)}
 
 
 def _resume_setup(args: argparse.Namespace) -> Any:

@@ -11,6 +11,7 @@ import time
 
 from station.commands._args import positive_number
 from station.errors import StationError
+from station.text import parse_channel_map
 
 DESCRIPTION = """\
 Open a gauge port and print each reading as it arrives (station channel, value,
@@ -106,25 +107,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
-def parse_map(text: str | None) -> dict[str, str]:
-    """``"1=x,2=y"`` -> ``{"1": "x", "2": "y"}``; StationError on a malformed pair."""
-    if not text:
-        return {}
-    mapping: dict[str, str] = {}
-    for pair in text.split(","):
-        device, sep, station = (part.strip() for part in pair.partition("="))
-        if not sep or not device or not station:
-            raise StationError(
-                f"--map {text!r}: write device=station pairs separated by commas, e.g. 1=x,2=y,3=z."
-            )
-        if device in mapping:
-            raise StationError(f"--map {text!r} names device channel {device} twice.")
-        mapping[device] = station
-    if len(set(mapping.values())) != len(mapping):
-        raise StationError(f"--map {text!r} maps two device channels to one station channel.")
-    return mapping
-
-
 def value_text(value: float, resolution: float) -> str:
     """A reading with its sign at the decimals a gauge of ``resolution`` shows (``+0.000``
     beside ``-0.001``); a value with finer digits than that keeps them (up to 6)."""
@@ -169,7 +151,7 @@ def run(args: argparse.Namespace) -> int:
     interval = positive_number(args.interval, "--interval")
     resolution = positive_number(args.resolution, "--resolution")
     settle = positive_number(args.settle, "--settle")
-    channel_map = parse_map(args.map)
+    channel_map = parse_channel_map(args.map)
     protocol = get_protocol(
         args.protocol,
         baudrate=args.baud,

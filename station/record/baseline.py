@@ -186,3 +186,23 @@ def baseline_for(robot: str) -> dict[str, Any] | None:
             "`station baseline ROBOT --clear` and set it again."
         )
     return record
+
+
+def header_baseline(robot: str, procedure: str, unit: str) -> dict[str, Any] | None:
+    """``robot``'s baseline as a new session's header records it (the phase II limits its live
+    alarms test against, and which session they came from), or None when it has none for this
+    procedure and unit (a baseline of another procedure or unit says nothing here)."""
+    record = baseline_for(robot)
+    if record is None or record.get("procedure") != procedure or record.get("unit") != unit:
+        return None
+    anchor = str(record.get("anchor") or "")
+    source = f"baseline of session {record.get('session')} ({record.get('date')})"
+    return {
+        "source": source,
+        "session": record.get("session"),
+        "anchor": anchor,
+        "limits": {
+            channel: {"center": spec["center"], "ucl": spec["ucl"], "lcl": spec["lcl"]}
+            for channel, spec in record["channels"].items()
+        },
+    }

@@ -85,6 +85,9 @@ class SessionSetup:
     """How many times each ``repeat`` block runs (fixture placements); ``None``: its target."""
     strokes: int | None = None
     """How many whole strokes each ``stroke`` step asks for; ``None``: its target."""
+    baseline: Mapping[str, Any] | None = None
+    """The robot's baseline (phase II limits and where they came from, as the header records
+    it), which the live alarms test against; ``None``: the limits freeze after phase I."""
 
     def __post_init__(self) -> None:
         if not self.robot.strip():
@@ -193,6 +196,7 @@ class SessionSetup:
             **({"strokes_target": self.strokes} if self.strokes else {}),
             "rules": self.rule_set,
             "threshold": self.threshold,
+            **({"baseline": dict(self.baseline)} if self.baseline else {}),
         }
         for step in self.procedure.all_steps():
             fields.update(handler_for(step.kind).header_fields(self, step))
@@ -233,6 +237,7 @@ def setup_from_header(
         threshold=float(header.get("threshold") or 1.0),
         placements=placements if isinstance(placements, int) else None,
         strokes=strokes if isinstance(strokes, int) else None,
+        baseline=header.get("baseline") if isinstance(header.get("baseline"), Mapping) else None,
     )
 
 

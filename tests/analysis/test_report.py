@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from station.analysis.capability import SpecLimits
-from station.analysis.report import format_histogram, format_report, verdict_word
+from station.analysis.report import format_histogram, format_report
 from station.analysis.summary import AnalysisConfig, analyze
+from station.text import verdict_word
 
 LIMITS = SpecLimits(lsl=-0.001, usl=0.001, nominal=0.0)
 

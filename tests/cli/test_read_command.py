@@ -152,7 +152,7 @@ def test_values_are_shown_at_the_resolutions_decimals() -> None:
             "There is no serial port /dev/ttyUSB_station_none",
         ),
         (["--port", "socket://127.0.0.1:1"], "refused the connection"),
-        (["--port", "/dev/null", "--map", "1x"], "--map '1x': write device=station pairs"),
+        (["--port", "/dev/null", "--map", "1x"], "--map: '1x' is not DEVICE=CHANNEL"),
         (["--port", "/dev/null", "--count", "zero"], "--count 'zero' is not a number"),
     ],
 )

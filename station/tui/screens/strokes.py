@@ -28,12 +28,13 @@ from textual.screen import Screen
 from textual.widgets import Footer, Static
 
 from station.errors import StationError
+from station.text import overall_verdict, verdict_word
 from station.tui.remedies import explained
 from station.tui.text import shown
 from station.tui.widgets.alarm_log import AlarmLog, alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.deviation_plot import DeviationData, DeviationPlot, trace
-from station.tui.widgets.figures import VERDICT_STYLES, decimals_for, overall_verdict, verdict_word
+from station.tui.widgets.figures import VERDICT_STYLES, decimals_for
 from station.tui.widgets.instrument_status import InstrumentStatus
 from station.tui.widgets.stats_panel import StatsPanel, StatsRows
 

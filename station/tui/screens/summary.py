@@ -22,15 +22,14 @@ from textual.screen import Screen
 from textual.widgets import Footer, Static
 
 from station.errors import StationError
+from station.text import overall_verdict, verdict_word
 from station.tui.remedies import explained
 from station.tui.text import shown, shown_line
 from station.tui.widgets.figures import (
     VERDICT_STYLES,
     decimals_for,
     number,
-    overall_verdict,
     ratio,
-    verdict_word,
 )
 
 if TYPE_CHECKING:
@@ -271,28 +270,19 @@ class SummaryScreen(Screen[None]):
         return self.view.path.with_name(self.view.path.stem + suffix)
 
     def action_export_report(self) -> None:
-        """The text report (the same as ``station analyze FILE``) beside the session file."""
-        from station.analysis.report import format_report
+        """The filed report (the same as ``station report FILE``: robot, operator, procedure,
+        gauges, zero, limits, every reading, notes, alarms, verdicts, anchor, sign-off) beside
+        the session file, as text and as a self-contained HTML page with its charts."""
+        from station.record.render import render_report
 
-        if self.view.analysis is None:
-            self.notify("No accepted cycles: there is no report to export.", severity="warning")
+        try:
+            text = render_report(self.view.path, "txt")
+            page = render_report(self.view.path, "html")
+        except StationError as error:
+            self.notify(shown_line(explained(error), limit=None), severity="error", markup=False)
             return
-        target = self._export_path(".report.txt")
-        notes = (
-            f"Session file {self.view.path.name}, status {self.view.status}.",
-            f"Last line hash (anchors the session file): {self.view.last_hash}",
-            *self.view.notes,
-        )
-        own = self.view.report
-        report = format_report(
-            self.view.analysis,
-            title=own.title
-            if own is not None
-            else f"BASIC STATISTICS COMPREHENSIVE REPORT ON {self.view.path.name}",
-            notes=notes,
-            sections=[list(section) for section in own.sections] if own is not None else [],
-        )
-        self._write(target, report, "report")
+        self._write(self._export_path(".report.txt"), text, "report")
+        self._write(self._export_path(".report.html"), page, "HTML report")
 
     def action_export_csv(self) -> None:
         """Every cycle as tidy CSV (rejected ones marked) beside the session file."""

@@ -6,7 +6,6 @@ Nothing here computes a statistic; it only formats what the analysis returned.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 NOT_AVAILABLE = "—"
 
@@ -36,24 +35,3 @@ def ratio(value: float | None) -> str:
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return NOT_AVAILABLE
     return f"{value:.2f}"
-
-
-def verdict_word(capability: Any) -> str:
-    """CAPABLE, NOT CAPABLE or UNDEFINED from ``capability.capable`` (True, False, None)."""
-    capable = getattr(capability, "capable", None) if capability is not None else None
-    if capable is True:
-        return "CAPABLE"
-    if capable is False:
-        return "NOT CAPABLE"
-    return "UNDEFINED"
-
-
-def overall_verdict(words: list[str]) -> str:
-    """The session's verdict: NOT CAPABLE if any axis is, CAPABLE if all are, else UNDEFINED."""
-    if not words:
-        return "UNDEFINED"
-    if "NOT CAPABLE" in words:
-        return "NOT CAPABLE"
-    if all(word == "CAPABLE" for word in words):
-        return "CAPABLE"
-    return "UNDEFINED"

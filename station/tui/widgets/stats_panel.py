@@ -16,8 +16,9 @@ from rich.table import Table
 from rich.text import Text
 from textual.widgets import Static
 
+from station.text import verdict_word
 from station.tui.text import shown_line
-from station.tui.widgets.figures import VERDICT_STYLES, number, ratio, verdict_word
+from station.tui.widgets.figures import VERDICT_STYLES, number, ratio
 
 
 @dataclass(frozen=True)
