@@ -11,16 +11,7 @@ from typing import Any
 
 from station.commands._args import parse_number
 from station.errors import StationError
-
-
-def _shown(text: str) -> str:
-    """Text from outside (a file name) with control and format characters made visible."""
-    import unicodedata
-
-    return "".join(
-        ch if ch.isprintable() and unicodedata.category(ch) != "Cf" else ascii(ch)[1:-1]
-        for ch in text
-    )
+from station.plain import plain
 
 
 def _gauge_check(args: argparse.Namespace, source: Any, path: Path) -> tuple[Any, dict, list]:
@@ -73,7 +64,7 @@ def run_method(args: argparse.Namespace, source: Any, procedure: str, path: Path
     is_session = hasattr(source, "session")
     if procedure == "gauge_check":
         result, document, lines = _gauge_check(args, source, path)
-        title = f"GAUGE CHECK REPORT ON {_shown(path.name)}"
+        title = f"GAUGE CHECK REPORT ON {plain(path.name)}"
     elif procedure == "joint_troubleshooting":
         if is_session:
             result = reports.joints_from_session(source.session)
@@ -84,7 +75,7 @@ def run_method(args: argparse.Namespace, source: Any, procedure: str, path: Path
             result = analyze_joints(joints, readings, lever_arms=levers)
         document = {"procedure": procedure, **result.as_json()}
         lines = reports.joints_lines(result, args.unit or getattr(source.config, "unit", ""))
-        title = f"PER-JOINT TROUBLESHOOTING REPORT ON {_shown(path.name)}"
+        title = f"PER-JOINT TROUBLESHOOTING REPORT ON {plain(path.name)}"
     else:
         if is_session:
             result = reports.gain_schedule_from_session(source.session)
@@ -100,11 +91,11 @@ def run_method(args: argparse.Namespace, source: Any, procedure: str, path: Path
             result = fit_schedule(q, gains)
         document = reports.gain_schedule_document(result, path.name)
         lines = reports.gain_schedule_lines(result)
-        title = f"GAIN SCHEDULE REPORT ON {_shown(path.name)}"
+        title = f"GAIN SCHEDULE REPORT ON {plain(path.name)}"
     if args.json:
         print(json.dumps(document, indent=2, allow_nan=False))
     else:
-        notes = [_shown(note) for note in getattr(source, "notes", ())]
+        notes = [plain(note) for note in getattr(source, "notes", ())]
         print("\n".join([title, *notes, "", *lines]))
     if args.fail_if_incapable and procedure == "gauge_check" and result.capable is not True:
         print(f"station: the gauge check failed ({result.verdict})", file=sys.stderr)

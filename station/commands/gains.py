@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from station.errors import StationError
+from station.plain import plain
 
 if TYPE_CHECKING:
     from station.analysis.gain_schedule import GainFit, GainSchedule
@@ -105,17 +106,6 @@ def read_gains(path: Path) -> tuple[Any, dict[str, Any]]:
     return position, gains
 
 
-def plain_text(text: str) -> str:
-    """Text from outside (a CSV header, a file name) as plain text: control characters and
-    bidi overrides shown as escapes, never acted on by the terminal."""
-    import unicodedata
-
-    return "".join(
-        ch if ch.isprintable() and unicodedata.category(ch) != "Cf" else ascii(ch)[1:-1]
-        for ch in text
-    )
-
-
 def gains_document(schedule: GainSchedule, source: str) -> dict[str, Any]:
     """The JSON document of ``station gains fit --json``."""
     return {"source": source, **schedule.as_json()}
@@ -148,7 +138,7 @@ def text_plot(fit: GainFit, width: int = PLOT_WIDTH, height: int = PLOT_HEIGHT) 
 def format_fit(fit: GainFit, *, plot: bool = True) -> list[str]:
     """One gain's report: order and how chosen, the scores per order, coefficients, residuals,
     warnings and the plot."""
-    name = plain_text(fit.name)
+    name = plain(fit.name)
     lines = [
         f"GAIN {name}: order {fit.order} ({fit.chosen_by}), "
         f"leave-one-out RMSE {_number(fit.loo_rmse)}, RMSE {_number(fit.rmse)}",
@@ -206,10 +196,10 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(gains_document(schedule, path.name), indent=2, allow_nan=False))
         return 0
-    print(f"GAIN SCHEDULE FROM {plain_text(path.name)}: {len(schedule.positions)} positions")
+    print(f"GAIN SCHEDULE FROM {plain(path.name)}: {len(schedule.positions)} positions")
     for fit in schedule.fits.values():
         print()
         print("\n".join(format_fit(fit, plot=not args.no_plot)))
     if args.c_out:
-        print(f"\nC header written to {plain_text(str(args.c_out))}")
+        print(f"\nC header written to {plain(str(args.c_out))}")
     return 0

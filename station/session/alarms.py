@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from station.errors import StationError
+from station.plain import plain
 from station.procedures import DEFAULT_CAUSES, OTHER_CAUSE
 
 if TYPE_CHECKING:
@@ -196,13 +197,6 @@ def format_recorded_alarms(alarms: Sequence[RecordedAlarm], width: int = 80) -> 
         else:
             lines.append("    not acknowledged")
     return lines
-
-
-def plain(text: str) -> str:
-    """Text from outside (an operator's cause, a journal's alarm text) with control characters
-    and bidi overrides made visible as ``\\uXXXX``, so a report shows what was typed.
-    (A local stand-in for the project's one text-sanitising function: swap it in at merge.)"""
-    return "".join(ch if ch.isprintable() else f"\\u{ord(ch):04x}" for ch in text)
 
 
 def recorded_alarms_json(alarms: Sequence[RecordedAlarm]) -> list[dict[str, Any]]:

@@ -37,5 +37,5 @@ def test_markdown_text_renders_as_the_text_itself(text):
 def test_plain_makes_controls_and_bidi_visible():
     assert plain("a\x1b[2Jb\x07") == "a\\x1b[2Jb\\x07"
     assert plain("x\u202ey\u2066") == "x\\u202ey\\u2066"
-    assert plain("line\nbreak\ttab") == "line\\x0abreak tab"
+    assert plain("line\nbreak\ttab") == "line\\nbreak\\ttab"
     assert plain("µm ±0.001 →") == "µm ±0.001 →"
