@@ -23,6 +23,9 @@ class ReviewScreen(Screen[None]):
 
     BINDINGS = [
         Binding("o", "open", "Open", key_display="enter/o"),
+        Binding("h", "history", "Robot history"),
+        Binding("m", "mark", "Mark for compare"),
+        Binding("c", "compare", "Compare with mark"),
         Binding("escape", "back", "Back"),
         Binding("f1", "help", "Help"),
         Binding("q", "back", "Back", show=False),
@@ -33,6 +36,7 @@ class ReviewScreen(Screen[None]):
     def __init__(self) -> None:
         super().__init__()
         self._sessions: list[Any] = []
+        self._marked: Any = None
 
     def compose(self) -> ComposeResult:
         """Title, the table, the folder."""
@@ -95,6 +99,48 @@ class ReviewScreen(Screen[None]):
             self.notify(shown_line(explained(error), limit=None), severity="error", markup=False)
             return
         self.app.push_screen(SummaryScreen(view, reviewing=True))
+
+    def _highlighted(self) -> Any:
+        table = self.query_one(DataTable)
+        if not self._sessions or table.cursor_row < 0:
+            return None
+        summary = self._sessions[table.cursor_row]
+        if summary.error:
+            self.notify(shown_line(summary.error, limit=None), severity="error", markup=False)
+            return None
+        return summary
+
+    def action_history(self) -> None:
+        """The highlighted robot's history: every session, its charts and wear trend."""
+        from station.tui.screens.record import history_screen
+
+        summary = self._highlighted()
+        if summary is not None:
+            self.app.push_screen(history_screen(self.app.config.sessions_dir, summary.robot))
+
+    def action_mark(self) -> None:
+        """Mark the highlighted session as the "before" of a comparison."""
+        summary = self._highlighted()
+        if summary is not None:
+            self._marked = summary
+            self.notify(
+                shown_line(
+                    f"{summary.path.name} marked: highlight another and press c", limit=None
+                ),
+                markup=False,
+            )
+
+    def action_compare(self) -> None:
+        """Compare the highlighted session with the marked one (before → after)."""
+        from station.tui.screens.record import compare_screen
+
+        summary = self._highlighted()
+        if summary is None:
+            return
+        if self._marked is None or self._marked.path == summary.path:
+            self.notify("Mark a session with m first, then highlight another.", markup=False)
+            return
+        self.app.push_screen(compare_screen(self._marked.path, summary.path))
 
     def action_back(self) -> None:
         """Back to the home screen."""
