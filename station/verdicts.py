@@ -22,17 +22,19 @@ import numpy as np
 
 from station.analysis.accuracy import accuracy_json, analyze_accuracy
 from station.analysis.linearity import (
-    StrokeProfile,
     analyze_linearity,
     linearity_json,
     linearity_summary,
-    profiles_from_stream,
-    profiles_from_table,
     tolerance_from_limits,
-    trim_dwell,
 )
 from station.analysis.live import LiveAnalysis
 from station.analysis.report import format_accuracy, format_linearity
+from station.analysis.strokes import (
+    StrokeProfile,
+    profiles_from_stream,
+    profiles_from_table,
+    trim_dwell,
+)
 from station.analysis.summary import Analysis, AnalysisConfig, analyze, to_json
 from station.errors import StationError
 from station.procedures import AnalysisNeeds, discover_procedures, register_analysis_needs

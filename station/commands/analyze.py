@@ -217,7 +217,7 @@ def table_times(table: Any) -> dict[str, Any] | None:
 
 def table_linearity_profiles(table: Any) -> list[Any]:
     """The strokes of a linearity CSV (columns stroke, s, h, v)."""
-    from station.analysis.linearity import profiles_from_table
+    from station.analysis.strokes import profiles_from_table
     from station.session.tables import require_columns
 
     columns = require_columns(table, LINEARITY_COLUMNS, "a linearity table")

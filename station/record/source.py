@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 from station.errors import StationError
 
 if TYPE_CHECKING:
-    from station.analysis.linearity import StrokeProfile
+    from station.analysis.strokes import StrokeProfile
     from station.session.model import Session
     from station.verdicts import SessionReport
 

@@ -13,19 +13,21 @@ from hypothesis import strategies as st
 
 from station.analysis.capability import SpecLimits
 from station.analysis.linearity import (
-    A_TO_B,
-    B_TO_A,
     analyze_linearity,
     convex_hull,
     linearity_json,
     linearity_summary,
     minimum_zone,
     path_repeatability,
+    straightness,
+    tolerance_from_limits,
+)
+from station.analysis.strokes import (
+    A_TO_B,
+    B_TO_A,
     profiles_from_stream,
     profiles_from_table,
     split_strokes,
-    straightness,
-    tolerance_from_limits,
 )
 from station.analysis.summary import AnalysisConfig
 from station.errors import StationError

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from station.analysis.linearity import A_TO_B, B_TO_A, TravelTracker, split_strokes
+from station.analysis.strokes import A_TO_B, B_TO_A, TravelTracker, split_strokes
 from station.instruments.simulator import BarModel
 
 

@@ -22,12 +22,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-from station.analysis.linearity import (  # noqa: E402
-    analyze_linearity,
-    minimum_zone,
-    profiles_from_stream,
-    split_strokes,
-)
+from station.analysis.linearity import analyze_linearity, minimum_zone  # noqa: E402
+from station.analysis.strokes import profiles_from_stream, split_strokes  # noqa: E402
 from station.instruments.simulator import BarModel  # noqa: E402
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from station.analysis.linearity import split_strokes
+from station.analysis.strokes import split_strokes
 from station.instruments.simulator import BarModel, TwoFixtureModel
 
 REPO = Path(__file__).resolve().parents[2]

@@ -11,7 +11,8 @@ import time
 import numpy as np
 import pytest
 
-from station.analysis.linearity import A_TO_B, B_TO_A, profiles_from_stream, straightness
+from station.analysis.linearity import straightness
+from station.analysis.strokes import A_TO_B, B_TO_A, profiles_from_stream
 from station.errors import StationError
 from station.instruments.base import Value
 from station.instruments.framing import FrameSplitter

@@ -3,7 +3,7 @@
 Every complete set is a point and every point is written, in ``samples`` events numbered by
 stroke (one per ``batch_seconds`` or ``batch_points``, so the fsync cost stays bounded). With
 :meth:`StrokeStep.stream` the strokes are split live by the travel of the step's direction
-channel (:class:`~station.analysis.linearity.TravelTracker`, with the deadband recorded in the
+channel (:class:`~station.analysis.strokes.TravelTracker`, with the deadband recorded in the
 session header); the last event of a whole stroke carries ``end: true`` and the batch analysis
 takes those strokes as they are. A lead-in (the robot was moving when streaming began) or a
 stroke cut short keeps its own number without the mark, and the analysis leaves it out.
@@ -16,7 +16,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from station.analysis.linearity import TravelTracker, stroke_deadband
+from station.analysis.strokes import TravelTracker, stroke_deadband
 from station.errors import StationError
 from station.procedures import Step, StepSchema
 from station.run.state import Action, Progress, StrokeOutcome
