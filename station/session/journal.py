@@ -114,6 +114,9 @@ class SessionWriter:
     def __init__(self, path: Path, fd: int, replay: Replay, size: int) -> None:
         self.path = path
         self._fd: int | None = fd
+        # The writer checks each event before it writes it; it keeps only what that needs (a
+        # session of hours stays small in memory; the file holds everything).
+        replay.keep_checks_only()
         self._replay = replay
         self._size = size
         self._lock = threading.Lock()

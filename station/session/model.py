@@ -432,6 +432,18 @@ class Replay:
     """The last line's own ``hash`` field: the anchor printed on summaries and reports."""
     chain_hash: str | None = None
     """The sha256 of the last line's bytes: the next line's ``prev``."""
+    checks_only: bool = False
+    """A writer's replay: keep what checking the next event needs (the header, the cycle numbers,
+    rejects, alarms, inputs), not every event's record, its readings or its streamed points, so
+    a long session's memory stays small (the file keeps everything)."""
+
+    def keep_checks_only(self) -> None:
+        """Drop what only a reader of the whole session needs (see :attr:`checks_only`)."""
+        self.checks_only = True
+        self.events.clear()
+        self.samples.clear()
+        self.notes.clear()
+        self.input_events.clear()
 
     def check(self, record: Mapping[str, Any]) -> None:
         """Raise ValueError naming the fault when ``record`` cannot come next."""
@@ -464,10 +476,16 @@ class Replay:
         if not self.header:
             self.header = record
             return
-        self.events.append(record)
+        if not self.checks_only:
+            self.events.append(record)
         self.last_seq = record["seq"]
         kind = record["type"]
-        if kind == "reading":
+        if kind == "reading" and self.checks_only:
+            # Checking later events needs the cycle's number, not its values.
+            self.cycles[record["cycle"]] = Cycle(
+                number=record["cycle"], seq=record["seq"], t=record["t"], step="", readings={}
+            )
+        elif kind == "reading":
             readings = {
                 channel: ChannelReading(
                     value=float(spec["value"]),
@@ -491,7 +509,7 @@ class Replay:
             )
         elif kind == "reject":
             self.rejected[record["cycle"]] = record["reason"]
-        elif kind == "note":
+        elif kind == "note" and not self.checks_only:
             self.notes.append(record)
         elif kind == "alarm":
             self.alarms.append(record)
@@ -499,10 +517,11 @@ class Replay:
             self.acks.append(record)
         elif kind == "input":
             self.inputs[record["step"]] = record["values"]
-            self.input_events.append(record)
+            if not self.checks_only:
+                self.input_events.append(record)
         elif kind == "zero":
             self.zeroes.append(record)
-        elif kind == "samples":
+        elif kind == "samples" and not self.checks_only:
             stroke = record.get("stroke")
             self.samples.append(
                 SampleBatch(

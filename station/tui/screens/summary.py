@@ -281,8 +281,8 @@ class SummaryScreen(Screen[None]):
         except StationError as error:
             self.notify(shown_line(explained(error), limit=None), severity="error", markup=False)
             return
-        self._write(self._export_path(".report.txt"), text, "report")
-        self._write(self._export_path(".report.html"), page, "HTML report")
+        if self._write(self._export_path(".report.txt"), text, "report"):
+            self._write(self._export_path(".report.html"), page, "HTML report")
 
     def action_export_csv(self) -> None:
         """Every cycle as tidy CSV (rejected ones marked) beside the session file."""
@@ -300,7 +300,8 @@ class SummaryScreen(Screen[None]):
         export_csv(session, buffer)
         self._write(self._export_path(".csv"), buffer.getvalue(), "CSV")
 
-    def _write(self, target: Path, content: str, what: str) -> None:
+    def _write(self, target: Path, content: str, what: str) -> bool:
+        """Write an export beside the session file; False (and a sentence) when refused."""
         from station.session.durable import write_text_durably
 
         try:
@@ -308,17 +309,18 @@ class SummaryScreen(Screen[None]):
             write_text_durably(target, content, not_over=self.view.path)
         except StationError as error:
             self.notify(shown_line(explained(error), limit=None), severity="error", markup=False)
-            return
+            return False
         except OSError as error:
             self.notify(
                 shown_line(f"could not write {target}: {error.strerror}", limit=None),
                 severity="error",
                 markup=False,
             )
-            return
+            return False
         self.exported.append(f"{what} exported to {target}")
         self._refresh_file()
         self.notify(shown_line(f"{what} exported to {target}", limit=None), markup=False)
+        return True
 
     def action_dashboard(self) -> None:
         """The statistics table and charts of this session, read-only."""
