@@ -29,6 +29,7 @@ from typing import Any
 
 from station.errors import StationError
 from station.record.source import AnalysedSession, analyse_session
+from station.session.durable import fsync_folder, make_folders
 
 FORMAT = "station-baseline/1"
 _UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
@@ -103,8 +104,6 @@ def make_baseline(analysed: AnalysedSession) -> dict[str, Any]:
 def _write_new(path: Path, text: str) -> None:
     """Write ``text`` to a private temporary file beside ``path`` (created exclusively, never
     following a link), sync it and rename it over ``path``; then sync the folder."""
-    from station.session.durable import fsync_folder, make_folders
-
     make_folders(path.parent)
     if path.is_symlink():
         raise StationError(f"{path} is a symbolic link; remove it, then set the baseline again.")

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from station.errors import StationError
+from station.record.content import decimals_for
 from station.record.source import analyse_session
 
 
@@ -293,8 +294,6 @@ def compare_sessions(
     readings_b = {name: c.readings for name, c in analysis_b.channels.items()}
     if not set(readings_a) & set(readings_b):
         raise StationError(f"{sa.path.name} and {sb.path.name} share no channel to compare.")
-    from station.record.content import decimals_for
-
     resolution = sa.header.get("resolution")
     places = decimals_for(resolution if isinstance(resolution, int | float) else None)
     axes = compare_channels(

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
 
+from station.analysis.report import decimals_for as report_decimals
 from station.record.source import AnalysedSession
 from station.text import NOT_AVAILABLE, format_value, verdict_word
 
@@ -359,8 +360,6 @@ def _readings(session: Any, resolution: float | None) -> tuple[ReadingRow, ...]:
 
 
 def _verdicts(analysed: AnalysedSession, resolution: float | None) -> tuple[Verdict, ...]:
-    from station.analysis.report import decimals_for as report_decimals
-
     if analysed.report is None or analysed.report.analysis is None:
         return ()
     verdicts = []
@@ -387,8 +386,6 @@ def _verdicts(analysed: AnalysedSession, resolution: float | None) -> tuple[Verd
 
 
 def _figures(analysed: AnalysedSession, resolution: float | None) -> tuple[tuple[str, str], ...]:
-    from station.analysis.report import decimals_for as report_decimals
-
     if analysed.report is None or analysed.report.analysis is None:
         return ()
     spatial = analysed.report.analysis.spatial

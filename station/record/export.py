@@ -21,6 +21,7 @@ from typing import TextIO
 
 from station.session.export import export_csv, one_line
 from station.session.model import Session, event_seconds
+from station.verdicts import session_accuracy_inputs, session_stroke_profiles
 
 LINEARITY_COLUMNS: tuple[str, ...] = ("stroke", "s", "h", "v")
 ACCURACY_COLUMNS: tuple[str, ...] = ("cycle", "placement", "x", "y", "z")
@@ -50,8 +51,6 @@ def _comments(session: Session, out: TextIO) -> None:
 def export_linearity_csv(session: Session, out: TextIO) -> int:
     """Write the whole strokes of a linearity session as ``stroke,s,h,v`` (one row per point,
     strokes numbered as the analysis numbers them); return the data rows."""
-    from station.verdicts import session_stroke_profiles
-
     _comments(session, out)
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(LINEARITY_COLUMNS)
@@ -68,8 +67,6 @@ def export_accuracy_csv(session: Session, out: TextIO) -> int:
     """Write a relative-accuracy session's accepted readings at fixture placements as
     ``cycle,placement,x,y,z`` and, when every placement has them, the teach pendant's
     ``px,py,pz``; return the data rows."""
-    from station.verdicts import session_accuracy_inputs
-
     _, _, pendant = session_accuracy_inputs(session)
     numbers = [
         n

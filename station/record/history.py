@@ -19,8 +19,11 @@ from pathlib import Path
 from typing import Any
 
 from station.errors import StationError
+from station.record.baseline import baseline_for
 from station.record.content import parse_time
 from station.record.source import analyse_session
+from station.record.text import plain
+from station.session.store import list_sessions
 from station.text import UNDEFINED, overall_verdict, verdict_word
 
 SECONDS_PER_DAY = 86400.0
@@ -218,9 +221,6 @@ def robot_history(folder: str | Path, robot: str) -> RobotHistory:
     """Every session of ``robot`` (exact name) in ``folder``, oldest first, with the trends.
     Files that do not load are left out (``station verify`` names them). StationError when
     the robot has no session there."""
-    from station.record.baseline import baseline_for
-    from station.session.store import list_sessions
-
     folder = Path(folder)
     summaries = [s for s in list_sessions(folder) if s.error is None and s.robot == robot]
     if not summaries:
@@ -329,8 +329,6 @@ def history_json(history: RobotHistory) -> dict[str, Any]:
 
 def format_history(history: RobotHistory) -> list[str]:
     """The text of ``station history``: the table, charts of RP and Cpk, the trends."""
-    from station.record.text import plain
-
     unit = history.unit
     lines = [f"History of robot {plain(history.robot)} ({len(history.entries)} sessions)"]
     lines.append(f"Sessions folder: {plain(history.folder)}")

@@ -13,6 +13,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from station.errors import StationError
+from station.session.model import load_session
+from station.verdicts import report_session, session_source, session_stroke_profiles
 
 if TYPE_CHECKING:
     from station.analysis.strokes import StrokeProfile
@@ -47,9 +49,6 @@ def analyse_session(path: str | Path) -> AnalysedSession:
     Raises StationError when the file is not an intact session file; a session with nothing to
     analyse yet is returned with ``problem`` set instead.
     """
-    from station.session.model import load_session
-    from station.verdicts import report_session, session_source, session_stroke_profiles
-
     path = Path(path)
     session = load_session(path, recover=False)
     source = session_source(session)
