@@ -15,10 +15,11 @@ from rich.console import Console
 from station.analysis.capability import SpecLimits
 from station.analysis.summary import AnalysisConfig, analyze
 from station.errors import StationError
+from station.text import overall_verdict, verdict_word
 from station.tui.screens.setup import limits_text, parse_channel_map, parse_limits_text
 from station.tui.widgets.alarm_log import alarm_lines
 from station.tui.widgets.control_chart import chart_data, render_chart
-from station.tui.widgets.figures import decimals_for, number, overall_verdict, verdict_word
+from station.tui.widgets.figures import decimals_for, number
 from station.tui.widgets.histogram import histogram_data, render_histogram
 from station.tui.widgets.stats_panel import StatsRows, stats_table
 
