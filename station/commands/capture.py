@@ -573,6 +573,13 @@ class _Printer:
         elif kind == "zero":
             zeroed = ", ".join(f"{ch} ({spec['method']})" for ch, spec in event["channels"].items())
             self._print(f"zeroed {zeroed}")
+        elif (
+            notice.message is not None
+            and notice.message.level == "info"
+            and notice.state.status == "finished"
+        ):
+            # What the analysis kind did with the finished session (a gauge check filed).
+            self._print(notice.message.text)
         elif notice.message is not None and notice.message.level == "warning":
             # Errors are not printed here: each one also ends the command with its own line.
             text = notice.message.text
@@ -749,35 +756,27 @@ def _ended(runner: Any, headless: _Headless) -> int | None:
 def _print_summary(runner: Any, analysis: Any) -> None:
     """The session's report as ``station analyze FILE`` prints it (through the analysis-kind
     registry, so a site's own procedure of a kind gets that kind's report)."""
-    from station.analysis.report import format_report
     from station.verdicts import analyze_session_file
 
-    report = None
-    if analysis is None:
-        print("no accepted cycles: nothing to analyse")
-    else:
-        try:
-            report = analyze_session_file(Path(runner.path))
-        except StationError as error:
+    report, problem = None, None
+    try:
+        # A kind that judges no cycles (a gain schedule) has a report all the same.
+        report = analyze_session_file(Path(runner.path))
+    except StationError as error:
+        problem = error
+    if report is None or report.empty:
+        if problem is not None and analysis is not None:
             # The session is finished and safe; only its report could not be made.
-            print(f"no report: {error.worded(CLI_REMEDIES)}")
-            report = None
-    if report is not None:
+            print(f"no report: {problem.worded(CLI_REMEDIES)}")
+        else:
+            print("no accepted cycles: nothing to analyse")
+    else:
         notes = [
             f"Robot {runner.setup.robot}, operator {runner.setup.operator or 'not given'}, "
             f"procedure {runner.setup.procedure.id} {runner.setup.procedure.version}.",
             f"Session file: {runner.path}",
             f"Last line hash (anchors the session file): {runner.last_hash}",
         ]
-        if report.analysis is not None:
-            print(
-                format_report(
-                    report.analysis,
-                    title=report.title,
-                    notes=notes,
-                    sections=[list(section) for section in report.sections],
-                ),
-                end="",
-            )
+        print(report.text(notes, alarms=False), end="")
     print(f"session file: {Path(runner.path)}")
     print(f"last hash: {runner.last_hash}")

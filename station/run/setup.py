@@ -21,6 +21,7 @@ from station.run.steps import handler_for
 from station.run.steps.base import PlanItem
 from station.session.header import header_limits
 from station.session.model import load_session
+from station.verdicts import kind_of
 
 
 @dataclass(frozen=True)
@@ -163,7 +164,7 @@ class SessionSetup:
     def header_fields(self) -> dict[str, Any]:
         """The session header's fields (the journal adds format, session id, created, prev).
         Each step kind in the plan may add fields of its own (a stroke step records the
-        deadband its split uses)."""
+        deadband its split uses), and so may the analysis kind."""
         fields: dict[str, Any] = {
             "procedure": {
                 "id": self.procedure.id,
@@ -196,6 +197,10 @@ class SessionSetup:
         }
         for step in self.procedure.all_steps():
             fields.update(handler_for(step.kind).header_fields(self, step))
+        # And the analysis kind (a repeatability session: the gauge checks covering its gauges).
+        kind = kind_of(self.procedure.analysis)
+        if kind.header_fields is not None:
+            fields.update(kind.header_fields(fields))
         return fields
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -13,14 +14,9 @@ from pathlib import Path
 
 import pytest
 
-from station.session.gauge_register import coverage, coverage_lines
-from station.session.method_reports import (
-    gauge_check_from_session,
-    joints_from_session,
-    method_count,
-    record_gauge_check,
-)
+from station.session.gauge_register import coverage, coverage_lines, load_register
 from station.session.model import load_session
+from station.verdicts import analyze_session_file
 
 STATION = [sys.executable, "-m", "station"]
 
@@ -39,7 +35,10 @@ def simulate(*args: str, protocol: str = "idh") -> tuple[subprocess.Popen, str]:
     return process, url
 
 
-def capture(url: str, folder: Path, procedure: str, *extra: str, protocol: str = "idh") -> Path:
+def capture(
+    url: str, folder: Path, procedure: str, *extra: str, protocol: str = "idh"
+) -> tuple[Path, str]:
+    """The session file and the summary ``station capture`` printed."""
     done = subprocess.run(
         [
             *STATION,
@@ -61,7 +60,7 @@ def capture(url: str, folder: Path, procedure: str, *extra: str, protocol: str =
         timeout=120,
     )
     assert done.returncode == 0, done.stderr
-    return next(folder.glob("*.jsonl"))
+    return next(folder.glob("*.jsonl")), done.stdout
 
 
 def analyze_json(path: Path) -> dict:
@@ -92,7 +91,7 @@ def test_gauge_check_session_is_analysed_and_filed(
         protocol=protocol,
     )
     try:
-        path = capture(
+        path, summary = capture(
             url,
             tmp_path / "sessions",
             "gauge_check",
@@ -116,14 +115,19 @@ def test_gauge_check_session_is_analysed_and_filed(
     # A software zero reads the plate once: that reading's own error (noise, and the display's
     # 0.0001 in step) is in every later reading, so the bias is known to about one step.
     assert study["bias"] == pytest.approx(bias, abs=0.00003 if protocol == "idh" else 0.00015)
+    # The capture summary is the kind's report, and the finished check filed itself in the
+    # gauge register (the test's own: STATION_GAUGES), with the line it was read on.
+    assert f"GAUGE CHECK (TYPE-1 STUDY): {'CAPABLE' if capable else 'NOT CAPABLE'}" in summary
+    assert "filed in the gauge register" in summary
     session = load_session(path)
-    register = tmp_path / "gauges.json"
-    record_gauge_check(session, gauge_check_from_session(session), register=register)
+    register = Path(os.environ["STATION_GAUGES"])
+    entry = load_register(register)["gauges"]["MIT-0042"]["checks"][-1]
+    assert entry["session"] == session.session_id and entry["port"]["url"] == url
     status = coverage({"x": "MIT-0042"}, dt.date.fromisoformat(session.created[:10]), path=register)
     assert status["x"].state == ("passed" if capable else "failed")
     line = coverage_lines(status)[0]
     assert ("gauge check passed on" in line) is capable
-    assert method_count("gauge_check", gauge_check_from_session(session)) == "25 readings"
+    assert analyze_session_file(path).count == "25 readings"
 
 
 @pytest.mark.parametrize("protocol", ["idh", "mitutoyo"])
@@ -140,7 +144,7 @@ def test_joint_troubleshooting_session_names_the_faulty_joint(tmp_path: Path, pr
         protocol=protocol,
     )
     try:
-        path = capture(
+        path, summary = capture(
             url,
             tmp_path / "sessions",
             "joint_troubleshooting",
@@ -162,8 +166,8 @@ def test_joint_troubleshooting_session_names_the_faulty_joint(tmp_path: Path, pr
     assert document["procedure"] == "joint_troubleshooting"
     assert document["suspect"] == 2 and document["cause"] == "backlash"
     assert all(j["n"] == 25 and j["lever_arm"] for j in document["joints"])
-    result = joints_from_session(load_session(path))
-    assert method_count("joint_troubleshooting", result) == "3 joints"
+    assert analyze_session_file(path).count == "3 joints"
+    assert "SUSPECT: joint 2." in summary
 
 
 def test_gain_schedule_session_from_typed_gains(tmp_path: Path):
@@ -176,7 +180,7 @@ def test_gain_schedule_session_from_typed_gains(tmp_path: Path):
     inputs.write_text("\n".join(rows) + "\n")
     simulator, url = simulate("--channels", "q")
     try:
-        path = capture(
+        path, summary = capture(
             url,
             tmp_path / "sessions",
             "gain_schedule",
@@ -198,3 +202,4 @@ def test_gain_schedule_session_from_typed_gains(tmp_path: Path):
     )
     assert document["gains"]["kd"]["order"] == 0
     assert len(document["positions"]) == 9
+    assert "GAIN SCHEDULE REPORT ON" in summary and "GAIN SCHEDULE: 9 positions" in summary
