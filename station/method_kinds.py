@@ -21,7 +21,6 @@ Imported by :mod:`station.verdicts` (at its end), which is all it takes to regis
 
 from __future__ import annotations
 
-
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -104,8 +103,7 @@ def _gauge_check(inputs: KindInputs) -> Judgement:
     channels = [name for name, values in inputs.channels.items() if len(values)]
     if inputs.header is None and len(inputs.channels) != 1:
         raise StationError(
-            "a gauge-check table has one column of readings; it has "
-            f"{', '.join(inputs.channels)}."
+            f"a gauge-check table has one column of readings; it has {', '.join(inputs.channels)}."
         )
     if not channels:
         raise StationError("the session has no accepted readings of the reference yet.")
@@ -259,5 +257,3 @@ register(
         count=lambda schedule: f"{len(schedule.positions)} positions",
     )
 )
-
-

@@ -36,8 +36,8 @@ from station.analysis.report import format_accuracy, format_linearity
 from station.analysis.summary import Analysis, AnalysisConfig, analyze, to_json
 from station.errors import StationError
 from station.procedures import AnalysisNeeds, discover_procedures, register_analysis_needs
-from station.session.gauge_register import coverage_fields
 from station.session.alarms import format_recorded_alarms, recorded_alarms, recorded_alarms_json
+from station.session.gauge_register import coverage_fields, gauge_block
 from station.session.header import analysis_config
 from station.session.model import Session, load_session
 
@@ -218,7 +218,6 @@ class SessionReport:
         if self.recorded_alarms is not None:
             document["recorded_alarms"] = recorded_alarms_json(self.recorded_alarms)
         return document
-
 
     @property
     def empty(self) -> bool:
@@ -631,21 +630,7 @@ def _repeatability(inputs: KindInputs) -> Judgement:
         if inputs.channels
         else None
     )
-    return Judgement(analysis, None, _gauge_sections(inputs.header))
-
-
-def _gauge_sections(header: Mapping[str, Any] | None) -> tuple[tuple[str, ...], ...]:
-    """The gauge checks a session recorded at its start (its header's ``gauge_checks``): one
-    block saying which check covers each gauge, or warning; none for a CSV table or a file
-    from before the gauge register."""
-    if header is None or "gauge_checks" not in header:
-        return ()
-    import datetime as dt
-
-    from station.session.gauge_register import verdict_lines
-
-    lines = verdict_lines(header, dt.date.today())
-    return (("GAUGE CHECKS (the gauge register when the session began)", *(f"  {line}" for line in lines)),)
+    return Judgement(analysis, None, gauge_block(inputs.header, inputs.width))
 
 
 def _linearity(inputs: KindInputs) -> Judgement:

@@ -76,6 +76,7 @@ _SETUP_OPTIONS = (
     ("--resolution", "resolution"),
     ("--placements", "placements"),
     ("--strokes", "strokes"),
+    ("--gauge", "gauge"),
 )
 """The options that set a new session up; a resumed session keeps what its header records (the
 same value again is accepted: a script may repeat its command line with ``--resume``)."""
@@ -142,6 +143,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--placements", metavar="N", help="fixture placements of a repeat block (procedure's)"
     )
     parser.add_argument("--strokes", metavar="N", help="whole strokes to stream (procedure's)")
+    parser.add_argument(
+        "--gauge",
+        metavar="CH=ID",
+        action="append",
+        default=[],
+        help="the id or serial of the gauge on channel CH, looked up in the gauge register "
+        "(repeatable; default: the gauge last checked on the same line)",
+    )
     parser.add_argument(
         "--deadband",
         metavar="D",
@@ -300,7 +309,22 @@ def _setup(args: argparse.Namespace) -> Any:
         cycles=_positive(args.cycles, "--cycles", int) if args.cycles else None,
         placements=_positive(args.placements, "--placements", int) if args.placements else None,
         strokes=_positive(args.strokes, "--strokes", int) if args.strokes else None,
+        gauges=_gauges(args.gauge, procedure.channels) or None,
     )
+
+
+def _gauges(items: list[str], channels: tuple[str, ...]) -> dict[str, str]:
+    """``--gauge CH=ID`` values: the gauge id on each channel."""
+    gauges: dict[str, str] = {}
+    for item in items:
+        channel, equals, gauge = item.partition("=")
+        if not equals or not gauge.strip() or channel.strip() not in channels:
+            raise StationError(
+                f"--gauge {item!r} is not CH=ID with CH one of {', '.join(channels)}; "
+                "write e.g. --gauge x=MIT-0042"
+            )
+        gauges[channel.strip()] = gauge.strip()
+    return gauges
 
 
 def _channel_map(args: argparse.Namespace, channels: tuple[str, ...]) -> dict[str, str]:
@@ -358,6 +382,14 @@ def _resume_conflicts(args: argparse.Namespace, setup: Any) -> list[str]:
                 if now is None or (now.lsl, now.usl) != (lsl, usl):
                     was = f"{now.lsl}:{now.usl}" if now is not None else "none"
                     conflicts.append(f"--limit {text} (the session's: {channel}={was})")
+            continue
+        if name == "gauge":
+            recorded_gauges = dict(setup.gauges or {})
+            for text in given:
+                channel, _, gauge = text.partition("=")
+                if recorded_gauges.get(channel.strip()) != gauge.strip():
+                    was = recorded_gauges.get(channel.strip(), "none")
+                    conflicts.append(f"--gauge {text} (the session's: {channel.strip()}={was})")
             continue
         value = recorded[name]
         if name in ("cycles", "placements", "strokes"):

@@ -86,6 +86,8 @@ class SessionSetup:
     """How many times each ``repeat`` block runs (fixture placements); ``None``: its target."""
     strokes: int | None = None
     """How many whole strokes each ``stroke`` step asks for; ``None``: its target."""
+    gauges: Mapping[str, str] | None = None
+    """The gauge id or serial on each channel (for the gauge register); ``None``: none named."""
 
     def __post_init__(self) -> None:
         if not self.robot.strip():
@@ -194,6 +196,7 @@ class SessionSetup:
             **({"strokes_target": self.strokes} if self.strokes else {}),
             "rules": self.rule_set,
             "threshold": self.threshold,
+            **({"gauges": dict(self.gauges)} if self.gauges else {}),
         }
         for step in self.procedure.all_steps():
             fields.update(handler_for(step.kind).header_fields(self, step))
@@ -238,6 +241,7 @@ def setup_from_header(
         threshold=float(header.get("threshold") or 1.0),
         placements=placements if isinstance(placements, int) else None,
         strokes=strokes if isinstance(strokes, int) else None,
+        gauges={str(c): str(g) for c, g in dict(header.get("gauges") or {}).items()} or None,
     )
 
 

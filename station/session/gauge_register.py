@@ -33,6 +33,7 @@ import fcntl
 import json
 import os
 import secrets
+import textwrap
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -420,3 +421,21 @@ def coverage_fields(
         gauges = named
         statuses = {channel: {"state": "unknown", "sentence": warning} for channel in channels}
     return {"gauges": gauges, "gauge_checks": statuses}
+
+
+def gauge_block(
+    header: Mapping[str, Any] | None, width: int = 80, today: dt.date | None = None
+) -> tuple[tuple[str, ...], ...]:
+    """The report block of the gauge checks a session recorded at its start (its header's
+    ``gauge_checks``): which check covers each gauge, or a warning, wrapped to ``width``. No
+    block for a CSV table (``header`` None) or a file from before the gauge register."""
+    if header is None or "gauge_checks" not in header:
+        return ()
+    lines = [
+        wrapped
+        for line in verdict_lines(header, today or dt.date.today())
+        for wrapped in textwrap.wrap(
+            line, width=max(width, 40), initial_indent="  ", subsequent_indent="      "
+        )
+    ]
+    return (("GAUGE CHECKS (the gauge register when the session began)", *lines),)

@@ -203,3 +203,68 @@ def test_gain_schedule_session_from_typed_gains(tmp_path: Path):
     assert document["gains"]["kd"]["order"] == 0
     assert len(document["positions"]) == 9
     assert "GAIN SCHEDULE REPORT ON" in summary and "GAIN SCHEDULE: 9 positions" in summary
+
+
+def test_a_repeatability_session_says_which_gauge_check_covers_it(tmp_path: Path):
+    """The gauge check files MIT-0042 in the register; a repeatability session that names it on
+    x records the check at its start, and its verdict (capture summary, analyze, the filed
+    report) says so, while y and z, checked by nobody, warn."""
+    bench, bench_url = simulate("--model", "gauge-bench", "--reference", "0.1")
+    try:
+        capture(
+            bench_url,
+            tmp_path / "checks",
+            "gauge_check",
+            "--cycles",
+            "25",
+            *("--input", "gauge=MIT-0042", "--input", "reference=0.1"),
+            *("--input", "tolerance=0.004"),
+        )
+    finally:
+        bench.send_signal(signal.SIGTERM)
+        bench.communicate(timeout=10)
+    fixture, url = simulate()
+    try:
+        path, summary = capture(
+            url, tmp_path / "sessions", "repeatability", "--cycles", "3", "--gauge", "x=MIT-0042"
+        )
+    finally:
+        fixture.send_signal(signal.SIGTERM)
+        fixture.communicate(timeout=10)
+    today = load_session(path).created[:10]
+    passed = f"x: gauge MIT-0042: gauge check passed on {today}"
+    assert passed in summary
+    assert "y: WARNING: no gauge check covers this channel" in summary
+    header = load_session(path).header
+    assert header["gauges"] == {"x": "MIT-0042"}
+    assert header["gauge_checks"]["x"]["state"] == "passed"
+    assert header["gauge_checks"]["z"]["state"] == "none"
+    analysed = subprocess.run(
+        [*STATION, "analyze", str(path)], capture_output=True, text=True, timeout=60
+    )
+    assert passed in analysed.stdout
+    report = subprocess.run(
+        [*STATION, "report", str(path)], capture_output=True, text=True, timeout=60
+    )
+    assert report.returncode == 0, report.stderr
+    assert passed in report.stdout
+
+
+def test_a_failed_gauge_check_warns_in_the_next_session(tmp_path: Path):
+    """The register says the gauge on the line failed its check: a session on that line and
+    device channel finds it without being told, and its verdict warns."""
+    from station.analysis.gauge_check import gauge_check
+    from station.session.gauge_register import record_check
+
+    fixture, url = simulate()
+    register = Path(os.environ["STATION_GAUGES"])
+    biased = gauge_check([0.1003, 0.1004, 0.1003, 0.1002] * 7, 0.1, 0.002, resolution=0.0001)
+    record_check(register, "DIAL-7", biased, when=dt.date.today(), port={"url": url, "device": "2"})
+    try:
+        path, summary = capture(url, tmp_path / "sessions", "repeatability", "--cycles", "3")
+    finally:
+        fixture.send_signal(signal.SIGTERM)
+        fixture.communicate(timeout=10)
+    assert "y: WARNING: gauge DIAL-7: its last gauge check" in summary
+    assert "failed" in summary
+    assert load_session(path).header["gauges"] == {"y": "DIAL-7"}

@@ -136,6 +136,9 @@ def verdict_text(view: SummaryView) -> Text:
     """The verdict block: overall, then one line per axis with Cp, Cpk and the reason."""
     analysis = view.analysis
     text = Text()
+    if analysis is None and view.report is not None and not view.report.empty:
+        # A kind that judges no readings (a gain schedule): its report block is the result.
+        return Text("No capability verdict: this procedure judges no readings (its report below).")
     if analysis is None:
         return Text("No accepted cycles: there is nothing to judge yet.", style="bold yellow")
     words = [verdict_word(c.capability) for c in analysis.channels.values()]
@@ -274,7 +277,8 @@ class SummaryScreen(Screen[None]):
         """The text report (the same as ``station analyze FILE``) beside the session file."""
         from station.analysis.report import format_report
 
-        if self.view.analysis is None:
+        own = self.view.report
+        if self.view.analysis is None and (own is None or own.empty):
             self.notify("No accepted cycles: there is no report to export.", severity="warning")
             return
         target = self._export_path(".report.txt")
@@ -283,7 +287,9 @@ class SummaryScreen(Screen[None]):
             f"Last line hash (anchors the session file): {self.view.last_hash}",
             *self.view.notes,
         )
-        own = self.view.report
+        if self.view.analysis is None:
+            self._write(target, own.text(notes, alarms=False), "report")
+            return
         report = format_report(
             self.view.analysis,
             title=own.title
