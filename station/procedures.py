@@ -152,6 +152,10 @@ class AnalysisNeeds:
     numbers: tuple[str, ...] = ()
     more_numbers: int = 0
     numbers_words: str = ""
+    limits: bool = True
+    """Whether the kind's verdict judges the session's spec limits (a gauge check judges
+    against its reference and tolerance, a gain schedule judges nothing): a set-up screen
+    asks for limits only when it does."""
 
 
 _ANALYSES: dict[str, AnalysisNeeds] = {
@@ -167,6 +171,7 @@ _ANALYSES: dict[str, AnalysisNeeds] = {
         facet_words="a cycles step (the repeated readings)",
         numbers=("reference", "tolerance"),
         numbers_words="an input step with number fields 'reference' and 'tolerance'",
+        limits=False,
     ),
     "joint_troubleshooting": AnalysisNeeds(
         facet="counts",
@@ -179,6 +184,7 @@ _ANALYSES: dict[str, AnalysisNeeds] = {
         more_numbers=1,
         numbers_words="an input step with a number field 'q' (the position) and one number "
         "field per gain",
+        limits=False,
     ),
 }
 
