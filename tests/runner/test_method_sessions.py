@@ -203,6 +203,12 @@ def test_gain_schedule_session_from_typed_gains(tmp_path: Path):
     assert document["gains"]["kd"]["order"] == 0
     assert len(document["positions"]) == 9
     assert "GAIN SCHEDULE REPORT ON" in summary and "GAIN SCHEDULE: 9 positions" in summary
+    # The filed report of a session without a capability analysis: the fit under VERDICTS.
+    report = subprocess.run(
+        [*STATION, "report", str(path)], capture_output=True, text=True, timeout=60
+    )
+    assert report.returncode == 0, report.stderr
+    assert "GAIN SCHEDULE: 9 positions" in report.stdout.split("VERDICTS", 1)[1]
 
 
 def test_a_repeatability_session_says_which_gauge_check_covers_it(tmp_path: Path):
