@@ -274,3 +274,23 @@ def test_a_failed_gauge_check_warns_in_the_next_session(tmp_path: Path):
     assert "y: WARNING: gauge DIAL-7: its last gauge check" in summary
     assert "failed" in summary
     assert load_session(path).header["gauges"] == {"y": "DIAL-7"}
+
+
+@pytest.mark.parametrize("given", ["q=MIT-0042", "x=", "MIT-0042"])
+def test_a_gauge_named_on_no_channel_is_refused_before_anything_is_written(
+    tmp_path: Path, given: str
+):
+    done = subprocess.run(
+        [
+            *STATION,
+            "capture",
+            *("--procedure", "repeatability", "--port", "loop://", "--protocol", "mitutoyo"),
+            *("--robot", "R1", "--sessions", str(tmp_path), "--gauge", given),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 2
+    assert "is not CH=ID with CH one of x, y, z" in done.stderr
+    assert not list(tmp_path.glob("*.jsonl"))
