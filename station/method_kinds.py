@@ -127,11 +127,15 @@ def _gauge_check(inputs: KindInputs) -> Judgement:
         nominal={channel: float(reference)},
     )
     analysis = _pooled(inputs, [channel], judged)
-    note = (
+    notes = [
         f"  (the verdict above judges {channel} against x_m ± 0.1·T at {CAPABLE_AT}: "
         "its Cp is Cg, its Cpk is Cgk)"
-    )
-    return Judgement(analysis, study, ((*study.lines(), note),))
+    ]
+    if inputs.header is not None and inputs.header.get("session"):
+        from station.session.gauge_register import filed_line
+
+        notes.append(f"  {filed_line(str(inputs.header['session']))}")
+    return Judgement(analysis, study, ((*study.lines(), *notes),))
 
 
 def file_gauge_check(path: Path, *, register_file: Path | None = None) -> list[str]:

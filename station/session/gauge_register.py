@@ -439,3 +439,18 @@ def gauge_block(
         )
     ]
     return (("GAUGE CHECKS (the gauge register when the session began)", *lines),)
+
+
+def filed_line(session_id: str, path: Path | None = None) -> str:
+    """Where a gauge-check session stands in the register: ``gauge register: G-1, passed on
+    DATE (this session)``, or that it is not filed (yet), or that the register cannot be read."""
+    try:
+        register = load_register(path or register_path())
+    except StationError as error:
+        return f"gauge register: cannot be read ({error.message})"
+    for gauge, record in (register.get("gauges") or {}).items():
+        for check in (record or {}).get("checks") or ():
+            if isinstance(check, Mapping) and check.get("session") == session_id:
+                name = "".join(ch if ch.isprintable() else "?" for ch in str(gauge))
+                return f"gauge register: {name}, {check.get('result')} on {check.get('date')}"
+    return "gauge register: this check is not filed (a finished session files itself)"

@@ -158,3 +158,15 @@ def test_a_new_session_records_the_gauge_checks_of_its_line(tmp_path: Path, monk
     register.write_text("{not json")
     damaged = coverage_fields(header, today)["gauge_checks"]["x"]["sentence"]
     assert damaged.startswith("WARNING: the gauge register cannot be read")
+
+
+def test_a_gauge_checks_report_says_where_it_stands_in_the_register(tmp_path: Path):
+    from station.session.gauge_register import filed_line
+
+    register = tmp_path / "gauges.json"
+    assert "not filed" in filed_line("s-1", register)
+    record_check(register, "G-1", GOOD, when=TODAY, session="s-1")
+    assert filed_line("s-1", register) == "gauge register: G-1, passed on 2026-11-29"
+    assert "not filed" in filed_line("s-2", register)
+    register.write_text("[]")
+    assert filed_line("s-1", register).startswith("gauge register: cannot be read")

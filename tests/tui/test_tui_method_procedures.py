@@ -153,6 +153,7 @@ async def test_gauge_check_through_the_tui(tmp_path: Path, simulator: str, tui) 
         await run_procedure(pilot, tui, "gauge_check", simulator, "1=x", "25", lambda _: typed)
         report = text_of(app, "#summary-report")
         assert "GAUGE CHECK (TYPE-1 STUDY): CAPABLE" in report
+        assert f"gauge register: MIT-0042, passed on {dt.date.today().isoformat()}" in report
         assert "25 readings" in text_of(app, "#summary-title")
         verdict = text_of(app, "#summary-verdict")
         assert "Verdict: CAPABLE" in verdict and "Cpk ≥ 1.33" in verdict
