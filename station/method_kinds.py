@@ -128,8 +128,8 @@ def _gauge_check(inputs: KindInputs) -> Judgement:
     )
     analysis = _pooled(inputs, [channel], judged)
     notes = [
-        f"  (the verdict above judges {channel} against x_m ± 0.1·T at {CAPABLE_AT}: "
-        "its Cp is Cg, its Cpk is Cgk)"
+        f"  The verdict above judges {channel} against x_m ± 0.1·T at {CAPABLE_AT}:",
+        "  its Cp is Cg and its Cpk is Cgk.",
     ]
     if inputs.header is not None and inputs.header.get("session"):
         from station.session.gauge_register import filed_line
