@@ -83,6 +83,28 @@ def _pooled(inputs: KindInputs, channels: Sequence[str], config: Any) -> Analysi
     return replace(analysis, hints=())
 
 
+def fitted(lines: Sequence[str], width: int) -> tuple[str, ...]:
+    """The report lines, each longer than ``width`` wrapped under its own indent (the TUI's
+    summary column is narrower than the 80 columns of a printed report)."""
+    import textwrap
+
+    out: list[str] = []
+    for line in lines:
+        if len(line) <= width:
+            out.append(line)
+            continue
+        indent = " " * (len(line) - len(line.lstrip()))
+        out.extend(
+            textwrap.wrap(
+                line.strip(),
+                width=max(width, 40),
+                initial_indent=indent,
+                subsequent_indent=indent + "  ",
+            )
+        )
+    return tuple(out)
+
+
 # -- gauge check -------------------------------------------------------------------------------
 
 
@@ -135,7 +157,7 @@ def _gauge_check(inputs: KindInputs) -> Judgement:
         from station.session.gauge_register import filed_line
 
         notes.append(f"  {filed_line(str(inputs.header['session']))}")
-    return Judgement(analysis, study, ((*study.lines(), *notes),))
+    return Judgement(analysis, study, (fitted([*study.lines(), *notes], inputs.width),))
 
 
 def file_gauge_check(path: Path, *, register_file: Path | None = None) -> list[str]:
@@ -197,7 +219,7 @@ def _joint_troubleshooting(inputs: KindInputs) -> Judgement:
         inputs = replace(inputs, channels=readings, cycles=None, times=None)
         axes = list(readings)
     analysis = _pooled(inputs, axes, inputs.config) if axes else None
-    return Judgement(analysis, result, (tuple(result.lines(inputs.config.unit)),))
+    return Judgement(analysis, result, (fitted(result.lines(inputs.config.unit), inputs.width),))
 
 
 # -- gain schedule -----------------------------------------------------------------------------
@@ -220,7 +242,8 @@ def _gain_schedule(inputs: KindInputs) -> Judgement:
     positions, gains = _gain_inputs(inputs)
     order = (inputs.options or {}).get("order", "auto")
     schedule = fit_schedule(positions, gains, order)
-    return Judgement(None, schedule, (tuple(method_reports.gain_schedule_lines(schedule)),))
+    lines = method_reports.gain_schedule_lines(schedule)
+    return Judgement(None, schedule, (fitted(lines, inputs.width),))
 
 
 # -- the kinds ---------------------------------------------------------------------------------

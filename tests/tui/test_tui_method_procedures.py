@@ -182,6 +182,8 @@ async def test_joint_troubleshooting_through_the_tui(tmp_path: Path, simulator: 
         )
         report = text_of(app, "#summary-report")
         assert "SUSPECT: joint 3." in report
+        # Wrapped to the summary's column, not cropped at its edge.
+        assert max(len(line) for line in app.screen.view.report.lines) <= 74
         assert "3 joints" in text_of(app, "#summary-title")
         view = app.screen.view
     document = analyze_json(view.path)
