@@ -296,3 +296,37 @@ def test_a_gauge_named_on_no_channel_is_refused_before_anything_is_written(
     assert done.returncode == 2
     assert "is not CH=ID with CH one of x, y, z" in done.stderr
     assert not list(tmp_path.glob("*.jsonl"))
+
+
+def test_a_register_that_cannot_be_written_is_a_warning_not_a_lost_check(tmp_path: Path):
+    """The register is a symbolic link (never followed): the finished check warns on stderr,
+    exits 0, and its session file and report are whole."""
+    target = tmp_path / "elsewhere.json"
+    target.write_text("{}")
+    link = tmp_path / "gauges.json"
+    link.symlink_to(target)
+    bench, url = simulate("--model", "gauge-bench", "--reference", "0.1", "--noise", "5e-5")
+    try:
+        done = subprocess.run(
+            [
+                *STATION,
+                "capture",
+                *("--procedure", "gauge_check", "--port", url, "--protocol", "idh"),
+                *("--robot", "bench", "--sessions", str(tmp_path / "s"), "--cycles", "25"),
+                *("--input", "gauge=G-1", "--input", "reference=0.1", "--input", "tolerance=0.004"),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            env={**os.environ, "STATION_GAUGES": str(link)},
+        )
+    finally:
+        bench.send_signal(signal.SIGTERM)
+        bench.communicate(timeout=10)
+    assert done.returncode == 0, done.stderr
+    assert "station: warning: the gauge register" in done.stderr
+    assert "symbolic link" in done.stderr
+    assert target.read_text() == "{}"
+    assert "GAUGE CHECK (TYPE-1 STUDY)" in done.stdout
+    path = next((tmp_path / "s").glob("*.jsonl"))
+    assert load_session(path).finished
