@@ -140,11 +140,22 @@ _STEP_SCHEMAS: dict[str, StepSchema] = {
 @dataclass(frozen=True)
 class AnalysisNeeds:
     """What a procedure must hold for an analysis kind: a step of a kind with ``facet`` (e.g.
-    ``direction`` for streamed strokes, ``block`` for placements) and these ``channels``."""
+    ``direction`` for streamed strokes, ``block`` for placements), inside a repeat block when
+    ``facet_in_block``; these ``channels``; and input steps with the number fields ``numbers``
+    plus ``more_numbers`` others (a gain schedule's position ``q`` and one field per gain).
+    ``facet_words`` and ``numbers_words`` say what is missing when a file lacks it."""
 
     facet: str | None = None
     facet_words: str = ""
     channels: tuple[str, ...] = ()
+    facet_in_block: bool = False
+    numbers: tuple[str, ...] = ()
+    more_numbers: int = 0
+    numbers_words: str = ""
+    limits: bool = True
+    """Whether the kind's verdict judges the session's spec limits (a gauge check judges
+    against its reference and tolerance, a gain schedule judges nothing): a set-up screen
+    asks for limits only when it does."""
 
 
 _ANALYSES: dict[str, AnalysisNeeds] = {
@@ -153,12 +164,28 @@ _ANALYSES: dict[str, AnalysisNeeds] = {
         facet="block", facet_words="a repeat block (one per placement)", channels=("x", "y", "z")
     ),
     "linearity": AnalysisNeeds(facet="direction", facet_words="a stroke step (streamed strokes)"),
-    # The method kinds of issue 15; their own checks are in _check_method_kind.
-    "gauge_check": AnalysisNeeds(facet="counts", facet_words="a cycles step (the readings)"),
-    "joint_troubleshooting": AnalysisNeeds(
-        facet="block", facet_words="a repeat block (one per joint)", channels=("x", "y", "z")
+    # The rest of the report's method (station.method_kinds registers them with these needs;
+    # they are known here too so that a file declaring them loads without the registry).
+    "gauge_check": AnalysisNeeds(
+        facet="counts",
+        facet_words="a cycles step (the repeated readings)",
+        numbers=("reference", "tolerance"),
+        numbers_words="an input step with number fields 'reference' and 'tolerance'",
+        limits=False,
     ),
-    "gain_schedule": AnalysisNeeds(),
+    "joint_troubleshooting": AnalysisNeeds(
+        facet="counts",
+        facet_in_block=True,
+        facet_words="a repeat block (one per joint) holding a cycles step",
+        channels=("x", "y", "z"),
+    ),
+    "gain_schedule": AnalysisNeeds(
+        numbers=("q",),
+        more_numbers=1,
+        numbers_words="an input step with a number field 'q' (the position) and one number "
+        "field per gain",
+        limits=False,
+    ),
 }
 
 
@@ -178,6 +205,11 @@ def register_analysis_needs(kind: str, needs: AnalysisNeeds) -> None:
 def step_kinds() -> tuple[str, ...]:
     """The step kinds a procedure file may use."""
     return tuple(_STEP_SCHEMAS)
+
+
+def analysis_needs(kind: str) -> AnalysisNeeds:
+    """What a procedure declaring ``analysis = kind`` must hold (KeyError for an unknown kind)."""
+    return _ANALYSES[kind]
 
 
 def analysis_kinds() -> tuple[str, ...]:
@@ -647,59 +679,36 @@ def _analysis_kind(
     if declared not in _ANALYSES:
         raise check.fail("", f"'analysis' must be one of {', '.join(_ANALYSES)}, not {declared!r}")
     needs = _ANALYSES[declared]
-    if needs.facet and not any(getattr(schema, needs.facet) for schema in schemas):
-        raise check.fail("", f"'analysis' {declared} needs {needs.facet_words}")
+    if needs.facet:
+        # A facet inside a block: the steps of the blocks (a cycles step per joint).
+        pool = (
+            [
+                _STEP_SCHEMAS[inner.kind]
+                for step in steps
+                if _STEP_SCHEMAS[step.kind].block
+                for inner in step.steps
+            ]
+            if needs.facet_in_block
+            else schemas
+        )
+        if not any(getattr(schema, needs.facet) for schema in pool):
+            raise check.fail("", f"'analysis' {declared} needs {needs.facet_words}")
     if not set(needs.channels) <= set(channels):
-        names = list(needs.channels)
-        listed = ", ".join(names[:-1]) + f" and {names[-1]}" if len(names) > 1 else names[0]
-        raise check.fail("", f"'analysis' {declared} needs the channels {listed}")
-    _check_method_kind(check, declared, steps, channels)
+        raise check.fail(
+            "", f"'analysis' {declared} needs the channels {', '.join(needs.channels)}"
+        )
+    numbers = _number_fields(steps)
+    if not set(needs.numbers) <= numbers or len(numbers) < len(needs.numbers) + needs.more_numbers:
+        raise check.fail("", f"'analysis' {declared} needs {needs.numbers_words}")
     return str(declared)
 
 
 def _number_fields(steps: tuple[Step, ...]) -> set[str]:
+    """The names of the number fields of every input step (a block's too)."""
     every = [*steps, *(inner for step in steps for inner in step.steps)]
     return {
         f.name for step in every if step.kind == "input" for f in step.fields if f.type == "number"
     }
-
-
-def _check_method_kind(
-    check: _Checker, declared: str, steps: tuple[Step, ...], channels: tuple[str, ...]
-) -> None:
-    """What the gauge check, per-joint troubleshooting and gain schedule analyses read: the
-    input fields and steps they need (so a site's edit that drops one fails on load)."""
-    every = [*steps, *(inner for step in steps for inner in step.steps)]
-    numbers = _number_fields(steps)
-    if declared == "gauge_check":
-        if not any(step.kind == "cycles" for step in every):
-            raise check.fail(
-                "", "'analysis' gauge_check needs a cycles step (the repeated readings)"
-            )
-        if not {"reference", "tolerance"} <= numbers:
-            raise check.fail(
-                "",
-                "'analysis' gauge_check needs an input step with number fields 'reference' "
-                "and 'tolerance'",
-            )
-    elif declared == "joint_troubleshooting":
-        if not any(
-            step.kind == "repeat" and any(inner.kind == "cycles" for inner in step.steps)
-            for step in steps
-        ):
-            raise check.fail(
-                "",
-                "'analysis' joint_troubleshooting needs a repeat block (one per joint) "
-                "holding a cycles step",
-            )
-        if not {"x", "y", "z"} <= set(channels):
-            raise check.fail("", "'analysis' joint_troubleshooting needs the channels x, y and z")
-    elif declared == "gain_schedule" and ("q" not in numbers or len(numbers) < 2):
-        raise check.fail(
-            "",
-            "'analysis' gain_schedule needs an input step with a number field 'q' (the "
-            "position) and one number field per gain",
-        )
 
 
 def _parse_limits(

@@ -39,6 +39,7 @@ from station.analysis.summary import Analysis, AnalysisConfig, analyze, to_json
 from station.errors import StationError
 from station.procedures import AnalysisNeeds, discover_procedures, register_analysis_needs
 from station.session.alarms import format_recorded_alarms, recorded_alarms, recorded_alarms_json
+from station.session.gauge_register import coverage_fields, gauge_block
 from station.session.header import analysis_config
 from station.session.model import Session, load_session
 
@@ -66,6 +67,13 @@ class KindInputs:
     """Kind-specific values (a reference size, a tolerance) from the command line or header."""
     times: Mapping[str, Any] | None = None
     """The time (s) of each reading per channel, for the drift's trend test."""
+    header: Mapping[str, Any] | None = None
+    """The session's header (None for a CSV table)."""
+    input_events: Sequence[Mapping[str, Any]] = ()
+    """The session's ``input`` events (values typed, with their placement); none for a CSV."""
+    table: Any = None
+    """The CSV table (``station.session.tables.ReadingTable``) a kind reads its own columns
+    from (a joint number, a lever arm, a position q); None for a session."""
 
 
 @dataclass(frozen=True)
@@ -126,6 +134,13 @@ class AnalysisKind:
     json: Callable[[Any], dict[str, Any]] | None = None
     count: Callable[[Any], str] | None = None
     """What a session measured, in words (``7 strokes``); None: its cycles."""
+    header_fields: Callable[[Mapping[str, Any]], dict[str, Any]] | None = None
+    """Fields a new session's header records for this kind, given the header's other fields
+    (the gauge checks that cover a repeatability session's gauges)."""
+    finished: Callable[[Path], Sequence[str]] | None = None
+    """Called once a session of this kind is finished and closed, with its file; returns the
+    operator messages to show (a gauge check filed in the gauge register). StationError: a
+    warning, never a lost session."""
 
 
 _KINDS: dict[str, AnalysisKind] = {}
@@ -189,17 +204,40 @@ class SessionReport:
 
     def document(self) -> dict[str, Any]:
         """The JSON document of ``station analyze --json``: the analysis, the kind's own figures
-        under its key (``linearity``, ``accuracy``...), and ``procedure`` (the kind)."""
-        if self.analysis is None:
-            raise ValueError("a report without an analysis has no JSON document")
-        document = to_json(self.analysis)
+        under its key (``linearity``, ``accuracy``...; at the top level for a kind without a
+        key), and ``procedure`` (the kind). A kind that judges no readings (a gain schedule)
+        has only its own figures."""
         kind = kind_of(self.kind)
-        if kind.json is not None and kind.json_key and self.result is not None:
-            document[kind.json_key] = kind.json(self.result)
+        own = kind.json is not None and self.result is not None
+        if self.analysis is None and not own:
+            raise ValueError("a report without an analysis has no JSON document")
+        document = {} if self.analysis is None else to_json(self.analysis)
+        if own and kind.json_key:
+            document[kind.json_key] = kind.json(self.result)  # type: ignore[misc]
+        elif own:
+            document.update(kind.json(self.result))  # type: ignore[misc]
         document["procedure"] = self.kind
         if self.recorded_alarms is not None:
             document["recorded_alarms"] = recorded_alarms_json(self.recorded_alarms)
         return document
+
+    @property
+    def empty(self) -> bool:
+        """True when there is nothing to report: no analysis and no result of the kind's."""
+        return self.analysis is None and self.result is None
+
+    def text(self, notes: Sequence[str] | None = None, *, alarms: bool = True) -> str:
+        """The text report as ``station analyze FILE`` prints it (``notes`` replace the
+        report's own); a kind that judges no readings prints its title, notes and blocks."""
+        from station.analysis.report import format_report
+
+        shown = list(self.notes if notes is None else notes)
+        sections = [list(section) for section in self.sections]
+        if alarms and self.alarm_lines:
+            sections.append(list(self.alarm_lines))
+        if self.analysis is not None:
+            return format_report(self.analysis, title=self.title, notes=shown, sections=sections)
+        return "\n".join([self.title, *shown, *("\n" + "\n".join(s) for s in sections)]) + "\n"
 
 
 def judge(kind: str, inputs: KindInputs, *, name: str, notes: Sequence[str] = ()) -> SessionReport:
@@ -412,6 +450,8 @@ def session_inputs(
         width=width,
         options=dict(options or {}),
         times=source.times,
+        header=session.header,
+        input_events=tuple(session.input_events),
     )
 
 
@@ -592,7 +632,7 @@ def _repeatability(inputs: KindInputs) -> Judgement:
         if inputs.channels
         else None
     )
-    return Judgement(analysis, None, ())
+    return Judgement(analysis, None, gauge_block(inputs.header, inputs.width))
 
 
 def _linearity(inputs: KindInputs) -> Judgement:
@@ -626,6 +666,8 @@ register(
         title="BASIC STATISTICS COMPREHENSIVE REPORT",
         batch=_repeatability,
         live=LiveCycles,
+        # The gauge checks that cover its gauges, from the gauge register at the start.
+        header_fields=lambda fields: coverage_fields(fields),
     )
 )
 register(
@@ -672,3 +714,8 @@ def analyze_session(session: Session) -> Analysis | None:
         cycles=cycles,
         times={name: times[name] for name in channels},
     )
+
+
+# The rest of the report's method (gauge check, per-joint troubleshooting, gain schedule): its
+# module registers its kinds with the functions above, so it is imported last.
+from station import method_kinds as _method_kinds  # noqa: E402, F401

@@ -218,7 +218,10 @@ def gauge_check(
     sd = float(readings.std(ddof=1))
     bias = mean - reference
     # The spread is zero when every reading is the same display value: no index is defined.
-    if sd > 0:
+    # Readings that differ by float rounding only (0.1 read as 0.30000000000000004 − 0.2 after
+    # a software zero) are the same value: their s of 1e-17 would give a Cg of 1e13.
+    same = float(np.ptp(readings)) <= 1e-9 * max(1.0, float(np.max(np.abs(readings))))
+    if sd > 0 and not same:
         k = PERCENT_OF_TOLERANCE / 100.0
         cg: float | None = (k * tolerance) / (SPREAD_SIGMAS * sd)
         cgk: float | None = (k / 2.0 * tolerance - abs(bias)) / (SPREAD_SIGMAS / 2.0 * sd)

@@ -247,7 +247,6 @@ def table_accuracy_inputs(table: Any) -> tuple[Any, dict[str, Any], dict[int, tu
 def run(args: argparse.Namespace) -> int:
     """Analyse FILE and print the text report or the JSON document."""
     from station.analysis.capability import SpecLimits
-    from station.analysis.report import format_report
     from station.analysis.summary import AnalysisConfig
 
     path = Path(args.file)
@@ -297,19 +296,26 @@ def run(args: argparse.Namespace) -> int:
     if freeze_after is not None:
         config = replace(config, freeze_after=freeze_after)
     procedure = args.procedure or source.analysis or "repeatability"
-    from station.session.method_reports import METHOD_KINDS
-
-    if procedure in METHOD_KINDS:  # gauge check, per-joint troubleshooting, gain schedule
-        from station.commands._methods import run_method
-
-        return run_method(args, source, procedure, path)
-    if args.reference is not None:
-        raise StationError("--reference is the reference size of --procedure gauge_check.")
     tolerance = parse_number(args.tolerance, "--tolerance")
     if tolerance is not None and not tolerance > 0:
         raise StationError(f"--tolerance {args.tolerance!r} must be greater than 0.")
-    if tolerance is not None and procedure != "linearity":
-        raise StationError("--tolerance is the straightness tolerance of --procedure linearity.")
+    reference = parse_number(args.reference, "--reference")
+    options: dict[str, Any] = {}
+    if procedure == "gauge_check":
+        # The gauge check's own values (a session's typed ones unless given here).
+        options = {
+            name: value
+            for name, value in (("reference", reference), ("tolerance", tolerance))
+            if value is not None
+        }
+        tolerance = None
+    elif reference is not None:
+        raise StationError("--reference is the reference size of --procedure gauge_check.")
+    elif tolerance is not None and procedure != "linearity":
+        raise StationError(
+            "--tolerance is the straightness tolerance of --procedure linearity (or the "
+            "tolerance T of --procedure gauge_check)."
+        )
     from station.verdicts import KindInputs, judge, report_session
 
     if isinstance(source, TableSource):
@@ -322,15 +328,18 @@ def run(args: argparse.Namespace) -> int:
             profiles=lambda: table_linearity_profiles(table),
             accuracy_inputs=lambda: table_accuracy_inputs(table),
             tolerance=tolerance,
-            options={},
+            options=options,
+            table=table,
             times=table_times(table),
         )
         report = judge(procedure, inputs, name=path.name)
     else:
-        report = report_session(source, config=config, kind=procedure, tolerance=tolerance)
-    analysis = report.analysis
-    if analysis is None:
+        report = report_session(
+            source, config=config, kind=procedure, tolerance=tolerance, options=options
+        )
+    if report.empty:
         raise StationError(f"{path}: the session has no accepted readings to analyse yet.")
+    analysis = report.analysis
 
     if args.json:
         # Indented for a person at a terminal; compact (json's C encoder, several times faster
@@ -338,23 +347,19 @@ def run(args: argparse.Namespace) -> int:
         indent = 2 if sys.stdout.isatty() else None
         print(json.dumps(report.document(), indent=indent, allow_nan=False))
     else:
-        print(
-            format_report(
-                analysis,
-                title=report.title,
-                notes=report.notes,
-                sections=[list(section) for section in report.sections]
-                + ([list(report.alarm_lines)] if report.alarm_lines else []),
-            )
-        )
+        print(report.text())
     if args.fail_if_incapable:
         # A channel without a verdict (no limits, too few readings) fails too: a script that
         # asks for the verdict must not pass on data that was never judged.
-        failed = [
-            f"{name} ({_failure(c)})"
-            for name, c in analysis.channels.items()
-            if c.capability.capable is not True or (c.verdict and c.verdict.provisional)
-        ]
+        failed = (
+            [
+                f"{name} ({_failure(c)})"
+                for name, c in analysis.channels.items()
+                if c.capability.capable is not True or (c.verdict and c.verdict.provisional)
+            ]
+            if analysis is not None
+            else [f"{procedure} (no verdict: it judges no readings)"]
+        )
         if failed:
             print(f"station: failed the capability check: {', '.join(failed)}", file=sys.stderr)
             return 1

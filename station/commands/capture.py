@@ -76,6 +76,7 @@ _SETUP_OPTIONS = (
     ("--resolution", "resolution"),
     ("--placements", "placements"),
     ("--strokes", "strokes"),
+    ("--gauge", "gauge"),
 )
 """The options that set a new session up; a resumed session keeps what its header records (the
 same value again is accepted: a script may repeat its command line with ``--resume``)."""
@@ -142,6 +143,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--placements", metavar="N", help="fixture placements of a repeat block (procedure's)"
     )
     parser.add_argument("--strokes", metavar="N", help="whole strokes to stream (procedure's)")
+    parser.add_argument(
+        "--gauge",
+        metavar="CH=ID",
+        action="append",
+        default=[],
+        help="the id or serial of the gauge on channel CH, looked up in the gauge register "
+        "(repeatable; default: the gauge last checked on the same line)",
+    )
     parser.add_argument(
         "--deadband",
         metavar="D",
@@ -303,7 +312,22 @@ def _setup(args: argparse.Namespace) -> Any:
         strokes=_positive(args.strokes, "--strokes", int) if args.strokes else None,
         # Live alarms test against the robot's baseline when it has one for this procedure.
         baseline=header_baseline(args.robot, procedure.id, args.unit or procedure.unit),
+        gauges=_gauges(args.gauge, procedure.channels) or None,
     )
+
+
+def _gauges(items: list[str], channels: tuple[str, ...]) -> dict[str, str]:
+    """``--gauge CH=ID`` values: the gauge id on each channel."""
+    gauges: dict[str, str] = {}
+    for item in items:
+        channel, equals, gauge = item.partition("=")
+        if not equals or not gauge.strip() or channel.strip() not in channels:
+            raise StationError(
+                f"--gauge {item!r} is not CH=ID with CH one of {', '.join(channels)}; "
+                "write e.g. --gauge x=MIT-0042"
+            )
+        gauges[channel.strip()] = gauge.strip()
+    return gauges
 
 
 def _channel_map(args: argparse.Namespace, channels: tuple[str, ...]) -> dict[str, str]:
@@ -361,6 +385,14 @@ def _resume_conflicts(args: argparse.Namespace, setup: Any) -> list[str]:
                 if now is None or (now.lsl, now.usl) != (lsl, usl):
                     was = f"{now.lsl}:{now.usl}" if now is not None else "none"
                     conflicts.append(f"--limit {text} (the session's: {channel}={was})")
+            continue
+        if name == "gauge":
+            recorded_gauges = dict(setup.gauges or {})
+            for text in given:
+                channel, _, gauge = text.partition("=")
+                if recorded_gauges.get(channel.strip()) != gauge.strip():
+                    was = recorded_gauges.get(channel.strip(), "none")
+                    conflicts.append(f"--gauge {text} (the session's: {channel.strip()}={was})")
             continue
         value = recorded[name]
         if name in ("cycles", "placements", "strokes"):
@@ -576,6 +608,13 @@ class _Printer:
         elif kind == "zero":
             zeroed = ", ".join(f"{ch} ({spec['method']})" for ch, spec in event["channels"].items())
             self._print(f"zeroed {zeroed}")
+        elif (
+            notice.message is not None
+            and notice.message.level == "info"
+            and notice.state.status == "finished"
+        ):
+            # What the analysis kind did with the finished session (a gauge check filed).
+            self._print(notice.message.text)
         elif notice.message is not None and notice.message.level == "warning":
             # Errors are not printed here: each one also ends the command with its own line.
             text = notice.message.text
@@ -753,35 +792,27 @@ def _ended(runner: Any, headless: _Headless) -> int | None:
 def _print_summary(runner: Any, analysis: Any) -> None:
     """The session's report as ``station analyze FILE`` prints it (through the analysis-kind
     registry, so a site's own procedure of a kind gets that kind's report)."""
-    from station.analysis.report import format_report
     from station.verdicts import analyze_session_file
 
-    report = None
-    if analysis is None:
-        print("no accepted cycles: nothing to analyse")
-    else:
-        try:
-            report = analyze_session_file(Path(runner.path))
-        except StationError as error:
+    report, problem = None, None
+    try:
+        # A kind that judges no cycles (a gain schedule) has a report all the same.
+        report = analyze_session_file(Path(runner.path))
+    except StationError as error:
+        problem = error
+    if report is None or report.empty:
+        if problem is not None and analysis is not None:
             # The session is finished and safe; only its report could not be made.
-            print(f"no report: {error.worded(CLI_REMEDIES)}")
-            report = None
-    if report is not None:
+            print(f"no report: {problem.worded(CLI_REMEDIES)}")
+        else:
+            print("no accepted cycles: nothing to analyse")
+    else:
         notes = [
             f"Robot {runner.setup.robot}, operator {runner.setup.operator or 'not given'}, "
             f"procedure {runner.setup.procedure.id} {runner.setup.procedure.version}.",
             f"Session file: {runner.path}",
             f"Last line hash (anchors the session file): {runner.last_hash}",
         ]
-        if report.analysis is not None:
-            print(
-                format_report(
-                    report.analysis,
-                    title=report.title,
-                    notes=notes,
-                    sections=[list(section) for section in report.sections],
-                ),
-                end="",
-            )
+        print(report.text(notes, alarms=False), end="")
     print(f"session file: {Path(runner.path)}")
     print(f"last hash: {runner.last_hash}")

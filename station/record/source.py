@@ -56,7 +56,7 @@ def analyse_session(path: str | Path) -> AnalysedSession:
         report = report_session(source)
     except StationError as error:
         return AnalysedSession(path, session, source.analysis, None, None, error.message)
-    if report.analysis is None:
+    if report.empty:
         return AnalysedSession(
             path, session, source.analysis, None, None, "the session has no accepted readings yet"
         )

@@ -511,8 +511,20 @@ class Runner:
             if not complete:
                 self.say("warning", "Finished before every step was done.")
             self._close()
+            self._kind_finished()
             self._notify(None, analysis=True)
             return self.analysis_or_none()
+
+    def _kind_finished(self) -> None:
+        """What the analysis kind does with a finished session (a gauge check files itself in
+        the gauge register); its failure is a warning: the session is safe on disk."""
+        if self.kind.finished is None:
+            return
+        try:
+            for sentence in self.kind.finished(self.path):
+                self.say("info", sentence)
+        except StationError as error:
+            self.say("warning", error.message)
 
     def interrupt(self, reason: str) -> None:
         """Write an ``interrupted`` event (``reason``: the signal's name, or why) and close the

@@ -21,6 +21,7 @@ from station.run.steps import handler_for
 from station.run.steps.base import PlanItem
 from station.session.header import header_limits
 from station.session.model import load_session
+from station.verdicts import kind_of
 
 
 @dataclass(frozen=True)
@@ -88,6 +89,8 @@ class SessionSetup:
     baseline: Mapping[str, Any] | None = None
     """The robot's baseline (phase II limits and where they came from, as the header records
     it), which the live alarms test against; ``None``: the limits freeze after phase I."""
+    gauges: Mapping[str, str] | None = None
+    """The gauge id or serial on each channel (for the gauge register); ``None``: none named."""
 
     def __post_init__(self) -> None:
         if not self.robot.strip():
@@ -166,7 +169,7 @@ class SessionSetup:
     def header_fields(self) -> dict[str, Any]:
         """The session header's fields (the journal adds format, session id, created, prev).
         Each step kind in the plan may add fields of its own (a stroke step records the
-        deadband its split uses)."""
+        deadband its split uses), and so may the analysis kind."""
         fields: dict[str, Any] = {
             "procedure": {
                 "id": self.procedure.id,
@@ -197,9 +200,14 @@ class SessionSetup:
             "rules": self.rule_set,
             "threshold": self.threshold,
             **({"baseline": dict(self.baseline)} if self.baseline else {}),
+            **({"gauges": dict(self.gauges)} if self.gauges else {}),
         }
         for step in self.procedure.all_steps():
             fields.update(handler_for(step.kind).header_fields(self, step))
+        # And the analysis kind (a repeatability session: the gauge checks covering its gauges).
+        kind = kind_of(self.procedure.analysis)
+        if kind.header_fields is not None:
+            fields.update(kind.header_fields(fields))
         return fields
 
 
@@ -238,6 +246,7 @@ def setup_from_header(
         placements=placements if isinstance(placements, int) else None,
         strokes=strokes if isinstance(strokes, int) else None,
         baseline=header.get("baseline") if isinstance(header.get("baseline"), Mapping) else None,
+        gauges={str(c): str(g) for c, g in dict(header.get("gauges") or {}).items()} or None,
     )
 
 

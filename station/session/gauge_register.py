@@ -33,6 +33,7 @@ import fcntl
 import json
 import os
 import secrets
+import textwrap
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -155,10 +156,13 @@ def record_check(
     when: dt.date,
     calibration_due: dt.date | str | None = None,
     session: str | None = None,
+    port: Mapping[str, str] | None = None,
 ) -> dict[str, Any]:
     """Add a Type-1 study of ``gauge`` done on ``when`` to the register at ``path`` (created
-    with its folder when missing); ``calibration_due`` updates the gauge's due date. Returns
-    the entry recorded. StationError when the register cannot be read or written."""
+    with its folder when missing); ``calibration_due`` updates the gauge's due date; ``port``
+    (``{"url", "device"}``: the line and device channel the gauge was read on) lets a later
+    session on that line find the gauge (:func:`gauges_on_ports`). Returns the entry recorded.
+    StationError when the register cannot be read or written."""
     key = _gauge_key(gauge)
     result = {"capable": "passed", "not capable": "failed"}.get(study.verdict, "no verdict")
     entry: dict[str, Any] = {
@@ -171,6 +175,8 @@ def record_check(
     }
     if session:
         entry["session"] = session
+    if port:
+        entry["port"] = {"url": str(port["url"]), "device": str(port["device"])}
     due = None if calibration_due in (None, "") else parse_date(calibration_due, "calibration due")
     try:
         make_folders(path.parent)
@@ -369,3 +375,98 @@ def all_covered(statuses: Mapping[str, GaugeStatus | Mapping[str, Any]]) -> bool
 def register_rows(register: Mapping[str, Any], today: dt.date) -> list[GaugeStatus]:
     """Every gauge in a loaded register with its status on ``today``, by id."""
     return [gauge_status(register, gauge, today) for gauge in sorted(register.get("gauges", {}))]
+
+
+def gauges_on_ports(register: Mapping[str, Any], ports: Any) -> dict[str, str]:
+    """Per station channel, the gauge whose newest check was read on the same line and device
+    channel (a session header's ``instruments.ports``: ``[{"url", "map": {device: channel}}]``).
+    A line named by ``/dev/serial/by-id/...`` or a device server's address keeps its name
+    from one day to the next; ``/dev/ttyUSB0`` may not, so name the gauge when in doubt."""
+    newest: dict[tuple[str, str], tuple[str, str]] = {}
+    for gauge, record in (register.get("gauges") or {}).items():
+        for check in (record or {}).get("checks") or ():
+            port = check.get("port") if isinstance(check, Mapping) else None
+            if not isinstance(port, Mapping):
+                continue
+            key = (str(port.get("url")), str(port.get("device")))
+            date = str(check.get("date") or "")
+            if key not in newest or newest[key][0] <= date:
+                newest[key] = (date, str(gauge))
+    found: dict[str, str] = {}
+    for port in ports or ():
+        if not isinstance(port, Mapping):
+            continue
+        for device, channel in dict(port.get("map") or {}).items():
+            hit = newest.get((str(port.get("url")), str(device)))
+            if hit is not None:
+                found.setdefault(str(channel), hit[1])
+    return found
+
+
+def coverage_fields(
+    fields: Mapping[str, Any],
+    today: dt.date | None = None,
+    *,
+    path: Path | None = None,
+) -> dict[str, Any]:
+    """What a new session's header records of its gauges (given the header's other fields):
+    ``gauges``, the gauge on each channel (named at set-up, else the one the register last saw
+    on its line and device channel), and ``gauge_checks``, each channel's
+    :meth:`GaugeStatus.as_json` on ``today``. A register that cannot be read is recorded as
+    a warning on every channel: the session starts all the same."""
+    today = today or dt.date.today()
+    channels = [str(c) for c in fields.get("channels") or ()]
+    named = session_gauges(fields)
+    try:
+        register = load_register(path or register_path())
+        ports = (fields.get("instruments") or {}).get("ports") or ()
+        gauges = {**gauges_on_ports(register, ports), **named}
+        gauges = {channel: gauges[channel] for channel in channels if channel in gauges}
+        statuses = {
+            channel: gauge_status(register, gauges[channel], today).as_json()
+            if channel in gauges
+            else {
+                **GaugeStatus("(not named)", "none", None, None).as_json(),
+                "sentence": "WARNING: no gauge check covers this channel (no gauge named, and "
+                "none checked on its line in the gauge register); run the gauge_check procedure",
+            }
+            for channel in channels
+        }
+    except StationError as error:
+        warning = f"WARNING: the gauge register cannot be read ({error.message})"
+        gauges = named
+        statuses = {channel: {"state": "unknown", "sentence": warning} for channel in channels}
+    return {"gauges": gauges, "gauge_checks": statuses}
+
+
+def gauge_block(
+    header: Mapping[str, Any] | None, width: int = 80, today: dt.date | None = None
+) -> tuple[tuple[str, ...], ...]:
+    """The report block of the gauge checks a session recorded at its start (its header's
+    ``gauge_checks``): which check covers each gauge, or a warning, wrapped to ``width``. No
+    block for a CSV table (``header`` None) or a file from before the gauge register."""
+    if header is None or "gauge_checks" not in header:
+        return ()
+    lines = [
+        wrapped
+        for line in verdict_lines(header, today or dt.date.today())
+        for wrapped in textwrap.wrap(
+            line, width=max(width, 40), initial_indent="  ", subsequent_indent="      "
+        )
+    ]
+    return (("GAUGE CHECKS (the gauge register when the session began)", *lines),)
+
+
+def filed_line(session_id: str, path: Path | None = None) -> str:
+    """Where a gauge-check session stands in the register: ``gauge register: G-1, passed on
+    DATE (this session)``, or that it is not filed (yet), or that the register cannot be read."""
+    try:
+        register = load_register(path or register_path())
+    except StationError as error:
+        return f"gauge register: cannot be read ({error.message})"
+    for gauge, record in (register.get("gauges") or {}).items():
+        for check in (record or {}).get("checks") or ():
+            if isinstance(check, Mapping) and check.get("session") == session_id:
+                name = "".join(ch if ch.isprintable() else "?" for ch in str(gauge))
+                return f"gauge register: {name}, {check.get('result')} on {check.get('date')}"
+    return "gauge register: this check is not filed (a finished session files itself)"

@@ -69,3 +69,13 @@ def test_no_spread_gives_no_verdict():
 def test_bad_input_is_a_sentence(values, tolerance, fragment):
     with pytest.raises(StationError, match=fragment):
         gauge_check(values, 1.0, tolerance)
+
+
+def test_readings_that_differ_by_float_rounding_only_have_no_spread():
+    """A software zero leaves 0.1 as 0.30000000000000004 − 0.2 in some readings: the study
+    must see one display value (no index), not an s of 1e-17 and a Cg of 1e13 (found on a
+    simulated bench whose indicator repeated to its last digit)."""
+    readings = [0.1, 0.30000000000000004 - 0.2] * 13
+    study = gauge_check(readings, 0.1, 0.004, resolution=0.0001)
+    assert study.cg is None and study.cgk is None and study.capable is None
+    assert study.verdict == "no verdict"

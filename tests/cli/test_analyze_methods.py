@@ -49,6 +49,15 @@ def test_gauge_check_json(gauge_csv: Path):
     assert study["resolution_ratio"] == pytest.approx(0.05)
     readings = np.loadtxt(gauge_csv, skiprows=2)
     assert study["cg"] == pytest.approx(0.0004 / (6 * readings.std(ddof=1)))
+    # Through the registry: the verdict's capability is the study (Cp = Cg, Cpk = Cgk).
+    capability = json.loads(result.stdout)["channels"]["x"]["capability"]
+    assert capability["cp"] == pytest.approx(study["cg"])
+    assert capability["cpk"] == pytest.approx(study["cgk"])
+    text = analyze(
+        gauge_csv, "--procedure", "gauge_check", "--reference", "0.1", "--tolerance", "0.002"
+    ).stdout
+    assert text.startswith("GAUGE CHECK REPORT ON gauge.csv")
+    assert max(len(line) for line in text.splitlines()) <= 80
 
 
 def test_gauge_check_with_a_bias_fails_and_exits_1_when_asked(gauge_csv: Path):
@@ -56,7 +65,7 @@ def test_gauge_check_with_a_bias_fails_and_exits_1_when_asked(gauge_csv: Path):
     result = analyze(gauge_csv, *common, "--reference", "0.0997")  # the gauge reads 0.0003 high
     assert result.returncode == 1
     assert "GAUGE CHECK (TYPE-1 STUDY): NOT CAPABLE" in result.stdout
-    assert "the gauge check failed" in result.stderr
+    assert "failed the capability check: x (not capable)" in result.stderr
 
 
 @pytest.mark.parametrize(

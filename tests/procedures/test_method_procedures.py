@@ -32,7 +32,7 @@ def test_builtin_procedures_declare_their_kind(kind):
             "joint_troubleshooting",
             'channels = ["x", "y", "z"]',
             'channels = ["x", "y"]',
-            "needs the channels x, y and z",
+            "needs the channels x, y, z",
         ),
         ("gain_schedule", 'name = "q"', 'name = "position"', "a number field 'q'"),
     ],

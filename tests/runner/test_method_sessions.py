@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -13,13 +14,9 @@ from pathlib import Path
 
 import pytest
 
-from station.session.gauge_register import coverage, coverage_lines
-from station.session.method_reports import (
-    gauge_check_from_session,
-    joints_from_session,
-    method_count,
-)
+from station.session.gauge_register import coverage, coverage_lines, load_register
 from station.session.model import load_session
+from station.verdicts import analyze_session_file
 
 STATION = [sys.executable, "-m", "station"]
 
@@ -38,7 +35,10 @@ def simulate(*args: str, protocol: str = "idh") -> tuple[subprocess.Popen, str]:
     return process, url
 
 
-def capture(url: str, folder: Path, procedure: str, *extra: str, protocol: str = "idh") -> Path:
+def capture(
+    url: str, folder: Path, procedure: str, *extra: str, protocol: str = "idh"
+) -> tuple[Path, str]:
+    """The session file and the summary ``station capture`` printed."""
     done = subprocess.run(
         [
             *STATION,
@@ -60,7 +60,7 @@ def capture(url: str, folder: Path, procedure: str, *extra: str, protocol: str =
         timeout=120,
     )
     assert done.returncode == 0, done.stderr
-    return next(folder.glob("*.jsonl"))
+    return next(folder.glob("*.jsonl")), done.stdout
 
 
 def gauges(*args: str) -> subprocess.CompletedProcess[str]:
@@ -95,7 +95,7 @@ def test_gauge_check_session_is_analysed_and_filed(
         protocol=protocol,
     )
     try:
-        path = capture(
+        path, summary = capture(
             url,
             tmp_path / "sessions",
             "gauge_check",
@@ -119,21 +119,21 @@ def test_gauge_check_session_is_analysed_and_filed(
     # A software zero reads the plate once: that reading's own error (noise, and the display's
     # 0.0001 in step) is in every later reading, so the bias is known to about one step.
     assert study["bias"] == pytest.approx(bias, abs=0.00003 if protocol == "idh" else 0.00015)
+    # The capture summary is the kind's report, and the finished check filed itself in the
+    # gauge register (the test's own: STATION_GAUGES), with the line it was read on.
+    assert f"GAUGE CHECK (TYPE-1 STUDY): {'CAPABLE' if capable else 'NOT CAPABLE'}" in summary
+    assert "filed in the gauge register" in summary
+    result = "passed" if capable else "failed"
+    assert f"gauge register: MIT-0042, {result} on" in summary
     session = load_session(path)
-    assert method_count("gauge_check", gauge_check_from_session(session)) == "25 readings"
-    # Filed in the register by `station gauges record`, then asked for by `station gauges status`.
-    register = tmp_path / "gauges.json"
-    recorded = gauges("record", str(path), "--register", str(register))
-    assert recorded.returncode == 0, recorded.stderr
-    assert f"gauge check {'passed' if capable else 'failed'} on {session.created[:10]}" in (
-        recorded.stdout
-    )
+    register = Path(os.environ["STATION_GAUGES"])
+    entry = load_register(register)["gauges"]["MIT-0042"]["checks"][-1]
+    assert entry["session"] == session.session_id and entry["port"]["url"] == url
     status = coverage({"x": "MIT-0042"}, dt.date.fromisoformat(session.created[:10]), path=register)
     assert status["x"].state == ("passed" if capable else "failed")
-    asked = gauges("status", "MIT-0042", "--register", str(register))
-    assert asked.returncode == (0 if capable else 1)
-    assert ("gauge MIT-0042: gauge check passed on" in asked.stdout) is capable
-    assert coverage_lines(status)[0].startswith("x: ")
+    line = coverage_lines(status)[0]
+    assert ("gauge check passed on" in line) is capable
+    assert analyze_session_file(path).count == "25 readings"
 
 
 @pytest.mark.parametrize("protocol", ["idh", "mitutoyo"])
@@ -150,7 +150,7 @@ def test_joint_troubleshooting_session_names_the_faulty_joint(tmp_path: Path, pr
         protocol=protocol,
     )
     try:
-        path = capture(
+        path, summary = capture(
             url,
             tmp_path / "sessions",
             "joint_troubleshooting",
@@ -172,8 +172,8 @@ def test_joint_troubleshooting_session_names_the_faulty_joint(tmp_path: Path, pr
     assert document["procedure"] == "joint_troubleshooting"
     assert document["suspect"] == 2 and document["cause"] == "backlash"
     assert all(j["n"] == 25 and j["lever_arm"] for j in document["joints"])
-    result = joints_from_session(load_session(path))
-    assert method_count("joint_troubleshooting", result) == "3 joints"
+    assert analyze_session_file(path).count == "3 joints"
+    assert "SUSPECT: joint 2." in summary
 
 
 def test_gain_schedule_session_from_typed_gains(tmp_path: Path):
@@ -186,7 +186,7 @@ def test_gain_schedule_session_from_typed_gains(tmp_path: Path):
     inputs.write_text("\n".join(rows) + "\n")
     simulator, url = simulate("--channels", "q")
     try:
-        path = capture(
+        path, summary = capture(
             url,
             tmp_path / "sessions",
             "gain_schedule",
@@ -208,21 +208,129 @@ def test_gain_schedule_session_from_typed_gains(tmp_path: Path):
     )
     assert document["gains"]["kd"]["order"] == 0
     assert len(document["positions"]) == 9
+    assert "GAIN SCHEDULE REPORT ON" in summary and "GAIN SCHEDULE: 9 positions" in summary
+    # The filed report of a session without a capability analysis: the fit under VERDICTS.
+    report = subprocess.run(
+        [*STATION, "report", str(path)], capture_output=True, text=True, timeout=60
+    )
+    assert report.returncode == 0, report.stderr
+    assert "GAIN SCHEDULE: 9 positions" in report.stdout.split("VERDICTS", 1)[1]
 
 
-def test_gauges_record_refuses_another_kind_of_session(tmp_path: Path):
-    from datetime import UTC, datetime
+def test_a_repeatability_session_says_which_gauge_check_covers_it(tmp_path: Path):
+    """The gauge check files MIT-0042 in the register; a repeatability session that names it on
+    x records the check at its start, and its verdict (capture summary, analyze, the filed
+    report) says so, while y and z, checked by nobody, warn."""
+    bench, bench_url = simulate("--model", "gauge-bench", "--reference", "0.1", "--noise", "5e-5")
+    try:
+        capture(
+            bench_url,
+            tmp_path / "checks",
+            "gauge_check",
+            "--cycles",
+            "25",
+            *("--input", "gauge=MIT-0042", "--input", "reference=0.1"),
+            *("--input", "tolerance=0.004"),
+        )
+    finally:
+        bench.send_signal(signal.SIGTERM)
+        bench.communicate(timeout=10)
+    fixture, url = simulate()
+    try:
+        path, summary = capture(
+            url, tmp_path / "sessions", "repeatability", "--cycles", "3", "--gauge", "x=MIT-0042"
+        )
+    finally:
+        fixture.send_signal(signal.SIGTERM)
+        fixture.communicate(timeout=10)
+    today = load_session(path).created[:10]
+    passed = f"x: gauge MIT-0042: gauge check passed on {today}"
+    assert passed in summary
+    assert "y: WARNING: no gauge check covers this channel" in summary
+    header = load_session(path).header
+    assert header["gauges"] == {"x": "MIT-0042"}
+    assert header["gauge_checks"]["x"]["state"] == "passed"
+    assert header["gauge_checks"]["z"]["state"] == "none"
+    analysed = subprocess.run(
+        [*STATION, "analyze", str(path)], capture_output=True, text=True, timeout=60
+    )
+    assert passed in analysed.stdout
+    report = subprocess.run(
+        [*STATION, "report", str(path)], capture_output=True, text=True, timeout=60
+    )
+    assert report.returncode == 0, report.stderr
+    assert passed in report.stdout
 
-    from station.session.journal import SessionWriter
-    from tests.session.conftest import session_header_fields
 
-    with SessionWriter.create(
-        tmp_path, session_header_fields(), now=datetime(2026, 11, 23, tzinfo=UTC)
-    ) as writer:
-        path = writer.path
-    result = gauges("record", str(path), "--register", str(tmp_path / "g.json"))
-    assert result.returncode == 2
-    assert "is a repeatability session, not a gauge check" in result.stderr
-    assert not (tmp_path / "g.json").exists()
-    listed = gauges("list", "--register", str(tmp_path / "g.json"))
-    assert listed.returncode == 0 and "no gauges recorded yet" in listed.stdout
+def test_a_failed_gauge_check_warns_in_the_next_session(tmp_path: Path):
+    """The register says the gauge on the line failed its check: a session on that line and
+    device channel finds it without being told, and its verdict warns."""
+    from station.analysis.gauge_check import gauge_check
+    from station.session.gauge_register import record_check
+
+    fixture, url = simulate()
+    register = Path(os.environ["STATION_GAUGES"])
+    biased = gauge_check([0.1003, 0.1004, 0.1003, 0.1002] * 7, 0.1, 0.002, resolution=0.0001)
+    record_check(register, "DIAL-7", biased, when=dt.date.today(), port={"url": url, "device": "2"})
+    try:
+        path, summary = capture(url, tmp_path / "sessions", "repeatability", "--cycles", "3")
+    finally:
+        fixture.send_signal(signal.SIGTERM)
+        fixture.communicate(timeout=10)
+    assert "y: WARNING: gauge DIAL-7: its last gauge check" in summary
+    assert "failed" in summary
+    assert load_session(path).header["gauges"] == {"y": "DIAL-7"}
+
+
+@pytest.mark.parametrize("given", ["q=MIT-0042", "x=", "MIT-0042"])
+def test_a_gauge_named_on_no_channel_is_refused_before_anything_is_written(
+    tmp_path: Path, given: str
+):
+    done = subprocess.run(
+        [
+            *STATION,
+            "capture",
+            *("--procedure", "repeatability", "--port", "loop://", "--protocol", "mitutoyo"),
+            *("--robot", "R1", "--sessions", str(tmp_path), "--gauge", given),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 2
+    assert "is not CH=ID with CH one of x, y, z" in done.stderr
+    assert not list(tmp_path.glob("*.jsonl"))
+
+
+def test_a_register_that_cannot_be_written_is_a_warning_not_a_lost_check(tmp_path: Path):
+    """The register is a symbolic link (never followed): the finished check warns on stderr,
+    exits 0, and its session file and report are whole."""
+    target = tmp_path / "elsewhere.json"
+    target.write_text("{}")
+    link = tmp_path / "gauges.json"
+    link.symlink_to(target)
+    bench, url = simulate("--model", "gauge-bench", "--reference", "0.1", "--noise", "5e-5")
+    try:
+        done = subprocess.run(
+            [
+                *STATION,
+                "capture",
+                *("--procedure", "gauge_check", "--port", url, "--protocol", "idh"),
+                *("--robot", "bench", "--sessions", str(tmp_path / "s"), "--cycles", "25"),
+                *("--input", "gauge=G-1", "--input", "reference=0.1", "--input", "tolerance=0.004"),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            env={**os.environ, "STATION_GAUGES": str(link)},
+        )
+    finally:
+        bench.send_signal(signal.SIGTERM)
+        bench.communicate(timeout=10)
+    assert done.returncode == 0, done.stderr
+    assert "station: warning: the gauge register" in done.stderr
+    assert "symbolic link" in done.stderr
+    assert target.read_text() == "{}"
+    assert "GAUGE CHECK (TYPE-1 STUDY)" in done.stdout
+    path = next((tmp_path / "s").glob("*.jsonl"))
+    assert load_session(path).finished

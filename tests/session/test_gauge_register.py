@@ -108,7 +108,9 @@ def test_a_repeatability_sessions_verdict_shows_its_gauge_check(tmp_path: Path):
     register = tmp_path / "gauges.json"
     record_check(register, "G-1", GOOD, when=dt.date(2026, 11, 2))
     record_check(register, "G-2", BIASED, when=dt.date(2026, 11, 20))
-    header = session_header_fields() | {"gauges": {"x": "G-1", "y": "G-2", "z": "G-3"}}
+    # A header that records gauge ids but no snapshot (the register is read when judged).
+    plain = {k: v for k, v in session_header_fields().items() if not k.startswith("gauge")}
+    header = plain | {"gauges": {"x": "G-1", "y": "G-2", "z": "G-3"}}
     moment = datetime(2026, 11, 23, 12, 0, 0, tzinfo=UTC)
     with SessionWriter.create(tmp_path / "sessions", header, now=moment) as writer:
         path = writer.path
@@ -127,4 +129,44 @@ def test_a_repeatability_sessions_verdict_shows_its_gauge_check(tmp_path: Path):
     record_check(register, "G-2", GOOD, when=dt.date(2026, 11, 28))
     assert verdict_lines(header | {"gauge_checks": snapshot}, TODAY, path=register) == lines
     assert verdict_lines(header, TODAY, path=register)[1].startswith("y: gauge G-2: gauge check")
-    assert "names no gauges" in verdict_lines(session_header_fields(), TODAY, path=register)[0]
+    assert "names no gauges" in verdict_lines(plain, TODAY, path=register)[0]
+
+
+def test_a_new_session_records_the_gauge_checks_of_its_line(tmp_path: Path, monkeypatch):
+    """At the start a session looks each channel's gauge up: the one named at set-up, else the
+    one last checked on the same line and device channel; the snapshot goes into the header
+    and its verdict block (wrapped to the report's width)."""
+    from station.session.gauge_register import coverage_fields, gauge_block
+    from tests.session.conftest import session_header_fields
+
+    today = dt.date.today()  # the header looks the gauges up on the day the session starts
+    register = tmp_path / "gauges.json"
+    monkeypatch.setenv("STATION_GAUGES", str(register))
+    record_check(register, "G-1", GOOD, when=today, port={"url": "loop://", "device": "1"})
+    record_check(register, "G-2", BIASED, when=today, port={"url": "loop://", "device": "2"})
+    record_check(register, "G-9", GOOD, when=today, port={"url": "other://", "device": "3"})
+    header = session_header_fields(gauges={"y": "G-1"})
+    assert header["gauges"] == {"x": "G-1", "y": "G-1"}  # named wins over the line's
+    assert [header["gauge_checks"][c]["state"] for c in "xyz"] == ["passed", "passed", "none"]
+    fields = coverage_fields(header, today)
+    assert fields["gauge_checks"] == header["gauge_checks"]
+    block = gauge_block(header, width=60)[0]
+    assert block[1] == f"  x: gauge G-1: gauge check passed on {today.isoformat()}"
+    assert max(len(line) for line in block) <= 60
+    assert any(line.startswith("  z: WARNING: no gauge check covers") for line in block)
+    # A damaged register: the session starts all the same, its verdict warns.
+    register.write_text("{not json")
+    damaged = coverage_fields(header, today)["gauge_checks"]["x"]["sentence"]
+    assert damaged.startswith("WARNING: the gauge register cannot be read")
+
+
+def test_a_gauge_checks_report_says_where_it_stands_in_the_register(tmp_path: Path):
+    from station.session.gauge_register import filed_line
+
+    register = tmp_path / "gauges.json"
+    assert "not filed" in filed_line("s-1", register)
+    record_check(register, "G-1", GOOD, when=TODAY, session="s-1")
+    assert filed_line("s-1", register) == "gauge register: G-1, passed on 2026-11-29"
+    assert "not filed" in filed_line("s-2", register)
+    register.write_text("[]")
+    assert filed_line("s-1", register).startswith("gauge register: cannot be read")

@@ -1,178 +1,114 @@
-"""The gauge check, per-joint troubleshooting and gain schedule through today's TUI at 80×24, by
-keyboard, against simulators on a real pty: the procedures run with the existing step kinds and
-screens, and ``station analyze FILE --json`` on the saved session gives their analysis."""
+"""The gauge check, per-joint troubleshooting and gain schedule through the TUI at 80×24, by
+keyboard, against ``station simulate`` (a real process on a real pty): set-up, every step of
+the checklist, the captures, finish, and the summary with the kind's own report. The gauge
+check then stands in the gauge register, and a repeatability session's summary names it."""
 
 from __future__ import annotations
 
+import datetime as dt
 import json
+import os
+import signal
 import subprocess
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from textual.widgets import Input, Select, Static
+from textual.widgets import Input, Static
 
-from station.instruments.gauge_bench import GaugeBenchModel
-from station.instruments.joint_model import faulty_arm
-from station.instruments.protocols import get_protocol
-from station.instruments.simulator import AxisModel, FixtureModel, GaugeSpec, Simulator
+from station.session.gauge_register import load_register
 from station.tui.app import StationApp, StationConfig
 from station.tui.screens.checklist import ChecklistScreen
 from station.tui.screens.dashboard import DashboardScreen
-from station.tui.screens.setup import SetupScreen
-from station.tui.screens.summary import SummaryScreen
+from station.tui.screens.summary import SummaryScreen, SummaryView
+
+STATION = [sys.executable, "-m", "station"]
+PROTOCOL = "mitutoyo"
+"""The set-up screen's first protocol (no zero command: the station zeroes in software)."""
 
 
-async def test_gauge_check_through_the_tui(tmp_path: Path, tui) -> None:
-    # idh zeroes the indicator itself (on the plate); the block reads 0.1 + 0.0002 in.
-    simulator = Simulator(get_protocol("idh"), GaugeBenchModel(0.1, bias=0.0002, noise=0.00005))
-    url = simulator.start_pty()
-    app = StationApp(StationConfig(sessions_dir=tmp_path, sessions_reason="test folder"))
+@pytest.fixture
+def simulator(request) -> Iterator[str]:
+    """``station simulate`` with the test's arguments (``request.param``); its URL."""
+    process = subprocess.Popen(
+        [*STATION, "simulate", "--protocol", PROTOCOL, *request.param],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    url = process.stdout.readline().strip()
     try:
-        async with app.run_test(size=(80, 24)) as pilot:
-            await pilot.press("n")
-            await tui.wait_until(pilot, lambda: isinstance(app.screen, SetupScreen))
-            await pilot.pause()
-            app.screen.query_one("#procedure", Select).value = "gauge_check"
+        if not url:
+            pytest.fail(f"the simulator gave no URL: {process.communicate(timeout=10)[1]}")
+        yield url
+    finally:
+        process.send_signal(signal.SIGTERM)
+        process.communicate(timeout=10)
+
+
+def text_of(app: StationApp, selector: str) -> str:
+    return str(app.screen.query_one(selector, Static).render())
+
+
+async def run_procedure(
+    pilot, tui, procedure: str, url: str, channel_map: str, count: str | None, values
+) -> None:
+    """Set up ``procedure`` on ``url`` and walk it by keyboard to the summary: Enter on
+    checks and zeros, the fields typed (``values(placement)``) at inputs, Space at captures,
+    ``f`` once every step is done."""
+    app = pilot.app
+    await pilot.pause()
+    app.screen.open_new(procedure)
+    await tui.wait_until(pilot, lambda: app.screen.query("#port"))
+    await pilot.pause()
+    await pilot.press(*"R1")
+    app.screen.query_one("#port", Input).value = url
+    app.screen.query_one("#map", Input).value = channel_map
+    if count is not None:
+        app.screen.query_one("#cycles", Input).value = count
+    for field in app.screen.query("Input"):
+        if str(field.id).startswith("limits-"):  # the report's ± 0.001 in, where asked
+            field.value = "±0.001"
+    await pilot.press("f2")
+    await pilot.pause()
+    errors = [str(w.render()) for w in app.screen.query(".field-error")]
+    assert app.runner is not None or not any(errors), errors
+    await tui.wait_until(pilot, lambda: app.runner is not None)
+    while (state := app.runner.state()).action.kind != "finish":
+        kind, step = state.action.kind, state.current
+        if kind == "capture":
+            await tui.wait_until(pilot, lambda: isinstance(app.screen, DashboardScreen))
+            if state.progress.done < state.progress.target:
+                await tui.capture_one(pilot)
+                continue
+            # Every cycle of the step is in: Go on (the next joint, or the finish).
+            await tui.wait_until(pilot, lambda: app.screen.check_action("go_on", ()))
+            await pilot.press("g")
             await tui.wait_until(
                 pilot,
-                lambda: (
-                    isinstance(app.screen, SetupScreen)
-                    and app.screen.procedure_id == "gauge_check"
-                    and bool(app.screen.query("#robot"))
+                lambda state=state: (
+                    app.runner.state().current is None
+                    or app.runner.state().current.index != state.current.index
                 ),
             )
-            await pilot.pause()
-            screen = app.screen
-            screen.query_one("#robot", Input).value = "bench"
-            screen.query_one("#port", Input).value = url
-            screen.query_one("#protocol", Select).value = "idh"
-            screen.query_one("#map", Input).value = "1=x"
-            screen.query_one("#cycles", Input).value = "25"
-            await pilot.pause()
-            # Today's set-up asks every procedure for limits per channel; the gauge check's own
-            # tolerance is typed at its input step (the limits are not used by its analysis).
-            screen.query_one("#limits-x", Input).value = "0.098:0.102"
-            await pilot.press("f2")
-            await tui.wait_until(pilot, lambda: app.runner is not None)
-            while app.runner.state().current is not None:
-                state = app.runner.state()
-                step = state.current
-                if step.kind == "input":
-                    await tui.wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen))
-                    await tui.wait_until(
-                        pilot, lambda: len(app.screen.query("#step-inputs Input")) == 4
-                    )
-                    fields = {f.id: f for f in app.screen.query("#step-inputs Input")}
-                    fields["input-gauge"].value = "MIT-0042"
-                    fields["input-reference"].value = "0.1"
-                    fields["input-tolerance"].value = "0.01"
-                    fields["input-calibration_due"].value = "2099-01-01"
-                    fields["input-gauge"].focus()
-                    await pilot.press("enter", "enter", "enter", "enter")
-                elif step.kind == "cycles":
-                    await tui.wait_until(pilot, lambda: isinstance(app.screen, DashboardScreen))
-                    await pilot.pause()
-                    while len(app.runner.state().cycles) < 25:
-                        await tui.capture_one(pilot)
-                    break
-                else:
-                    await tui.wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen))
-                    screen = app.screen
-                    await tui.wait_until(pilot, lambda screen=screen: not screen.busy)
-                    await pilot.press("enter")
-                await tui.wait_until(
-                    pilot,
-                    lambda state=state: (
-                        app.runner.state().current is None
-                        or app.runner.state().current.index != state.current.index
-                    ),
-                )
-            await pilot.pause()
-            await pilot.press("f")
-            await tui.wait_until(pilot, lambda: isinstance(app.screen, SummaryScreen))
-            path = app.screen.view.path
-    finally:
-        simulator.stop()
-    result = subprocess.run(
-        [sys.executable, "-m", "station", "analyze", str(path), "--json"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
-    assert result.returncode == 0, result.stderr
-    study = json.loads(result.stdout)["gauge_check"]
-    assert study["n"] == 25 and study["reference"] == 0.1 and study["tolerance"] == 0.01
-    assert abs(study["bias"] - 0.0002) < 0.00004, study
-    # Cgk = (0.001 - 0.0002) / (3 s), s about 0.00007 (noise and the 0.0001 in display): ~3.8.
-    assert study["capable"] is True, study
-
-
-async def set_up(pilot, tui, procedure: str, url: str, channel_map: str, count: str) -> None:
-    """Home → n → the set-up of ``procedure`` on ``url`` (idh) → F2."""
-    app = pilot.app
-    await pilot.press("n")
-    await tui.wait_until(pilot, lambda: isinstance(app.screen, SetupScreen))
-    await pilot.pause()
-    app.screen.query_one("#procedure", Select).value = procedure
-    await tui.wait_until(
-        pilot,
-        lambda: (
-            isinstance(app.screen, SetupScreen)
-            and app.screen.procedure_id == procedure
-            and bool(app.screen.query("#robot"))
-        ),
-    )
-    await pilot.pause()
-    screen = app.screen
-    screen.query_one("#robot", Input).value = "arm"
-    screen.query_one("#port", Input).value = url
-    screen.query_one("#protocol", Select).value = "idh"
-    screen.query_one("#map", Input).value = channel_map
-    screen.query_one("#cycles", Input).value = count
-    # Today's set-up asks every procedure for limits per channel (unused by these analyses).
-    for field in screen.query("Input"):
-        if (field.id or "").startswith("limits-"):
-            field.value = "-0.01:0.01"
-    await pilot.pause()
-    await pilot.press("f2")
-    await tui.wait_until(pilot, lambda: app.runner is not None)
-
-
-async def walk(pilot, tui, inputs) -> Path:
-    """Every step to the end: Enter on checks and zeroes, ``inputs(step)`` typed at input steps,
-    Space until a cycles step is done; then f and the summary. The session file's path."""
-    app = pilot.app
-    while app.runner.state().current is not None:
-        state = app.runner.state()
-        step = state.current
-        if step.kind == "input":
-            await tui.wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen))
-            values = inputs(step)
-            wanted = len(values)
+            continue
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen))
+        screen = app.screen
+        await tui.wait_until(pilot, lambda screen=screen: not screen.busy)
+        if kind == "input":
+            fields = state.action.fields
             await tui.wait_until(
-                pilot, lambda n=wanted: len(app.screen.query("#step-inputs Input")) == n
+                pilot,
+                lambda fields=fields: len(app.screen.query("#step-inputs Input")) == len(fields),
             )
-            fields = {f.id: f for f in app.screen.query("#step-inputs Input")}
-            for name, value in values.items():
-                fields[f"input-{name}"].value = value
-            fields[f"input-{next(iter(values))}"].focus()
-            await pilot.press(*["enter"] * len(values))
-        elif step.kind == "cycles":
-            await tui.wait_until(pilot, lambda: isinstance(app.screen, DashboardScreen))
-            await pilot.pause()
-            prompt = str(app.screen.query_one("#dash-prompt", Static).render())
-            if "Every cycle asked for is captured" in prompt:
-                pytest.fail(
-                    f"step {step.id} (placement {step.placement}) has all its cycles, more steps "
-                    "follow, and the dashboard offers only 'f to finish'"
+            typed = values(step.placement)
+            for field in fields:
+                app.screen.query_one(f"#input-{field.name}", Input).value = typed.get(
+                    field.name, ""
                 )
-            await tui.capture_one(pilot)
-        else:
-            await tui.wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen))
-            screen = app.screen
-            await tui.wait_until(pilot, lambda screen=screen: not screen.busy)
-            await pilot.press("enter")
+            app.screen.query_one(f"#input-{fields[-1].name}", Input).focus()
+        await pilot.press("enter")
         await tui.wait_until(
             pilot,
             lambda state=state: (
@@ -180,72 +116,127 @@ async def walk(pilot, tui, inputs) -> Path:
                 or app.runner.state().current.index != state.current.index
                 or len(app.runner.state().cycles) != len(state.cycles)
             ),
+            timeout=30,
         )
-    # With every step done the app shows the dashboard, where f finishes.
     await tui.wait_until(pilot, lambda: isinstance(app.screen, DashboardScreen))
     await pilot.pause()
     await pilot.press("f")
-    await tui.wait_until(pilot, lambda: isinstance(app.screen, SummaryScreen))
-    return app.screen.view.path
+    await tui.wait_until(pilot, lambda: isinstance(app.screen, SummaryScreen), timeout=30)
+    await pilot.pause()
+
+
+def tui_app(tmp_path: Path) -> StationApp:
+    return StationApp(
+        StationConfig(
+            sessions_dir=tmp_path / "sessions",
+            sessions_reason="test folder",
+            capture_timeout=3.0,
+        )
+    )
 
 
 def analyze_json(path: Path) -> dict:
-    result = subprocess.run(
-        [sys.executable, "-m", "station", "analyze", str(path), "--json"],
-        capture_output=True,
-        text=True,
-        timeout=60,
+    done = subprocess.run(
+        [*STATION, "analyze", str(path), "--json"], capture_output=True, text=True, timeout=60
     )
-    assert result.returncode == 0, result.stderr
-    return json.loads(result.stdout)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="today's TUI cannot go on from a cycles step inside a repeat block: after joint 1's "
-    "25 returns the dashboard offers only 'f to finish' (station capture confirms the step and "
-    "goes on). Remove this mark when the engine's cycles handler advances.",
+@pytest.mark.parametrize(
+    "simulator", [("--model", "gauge-bench", "--reference", "0.1", "--seed", "3")], indirect=True
 )
-async def test_joint_troubleshooting_through_the_tui(tmp_path: Path, tui) -> None:
-    # Joint 3 has backlash; idh zeroes the indicators itself at each joint's zero step.
-    arm = faulty_arm(3, "backlash")
-    simulator = Simulator(get_protocol("idh"), arm, seed=2)
-    url = simulator.start_pty()
-    levers = arm.lever_arms()
-    app = StationApp(StationConfig(sessions_dir=tmp_path, sessions_reason="test folder"))
-    try:
-        async with app.run_test(size=(80, 24)) as pilot:
-            await set_up(pilot, tui, "joint_troubleshooting", url, "1=x,2=y,3=z", "3")
-            path = await walk(
-                pilot, tui, lambda step: {"lever": f"{levers[step.placement - 1]:.3f}"}
-            )
-    finally:
-        simulator.stop()
-    document = analyze_json(path)
-    assert [j["n"] for j in document["joints"]] == [25, 25, 25]
-    assert document["suspect"] == 3 and document["cause"] == "backlash", document["reason"]
-    assert document["compared"] == "angular spread"
+async def test_gauge_check_through_the_tui(tmp_path: Path, simulator: str, tui) -> None:
+    app = tui_app(tmp_path)
+    typed = {"gauge": "MIT-0042", "reference": "0.1", "tolerance": "0.004"}
+    async with app.run_test(size=(80, 24)) as pilot:
+        await run_procedure(pilot, tui, "gauge_check", simulator, "1=x", "25", lambda _: typed)
+        report = text_of(app, "#summary-report")
+        assert "GAUGE CHECK (TYPE-1 STUDY): CAPABLE" in report
+        assert f"gauge register: MIT-0042, passed on {dt.date.today().isoformat()}" in report
+        assert "25 readings" in text_of(app, "#summary-title")
+        verdict = text_of(app, "#summary-verdict")
+        assert "Verdict: CAPABLE" in verdict and "Cpk ≥ 1.33" in verdict
+        view = app.screen.view
+    document = analyze_json(view.path)
+    study = document["gauge_check"]
+    assert study["capable"] is True and study["n"] == 25
+    # The summary's verdict is the study's: Cp is Cg, Cpk is Cgk.
+    x = view.analysis.channels["x"].capability
+    assert x.cp == pytest.approx(study["cg"]) and x.cpk == pytest.approx(study["cgk"])
+    # Finished, the check filed itself in the gauge register, with the line it was read on.
+    entry = load_register(Path(os.environ["STATION_GAUGES"]))["gauges"]["MIT-0042"]["checks"][-1]
+    assert entry["result"] == "passed" and entry["port"] == {"url": simulator, "device": "1"}
 
 
-async def test_gain_schedule_through_the_tui(tmp_path: Path, tui) -> None:
-    # No gauge is read, but today's set-up still wants a line for the procedure's channel q.
-    model = FixtureModel({"q": AxisModel()}, GaugeSpec())
-    simulator = Simulator(get_protocol("idh"), model)
-    url = simulator.start_pty()
-    app = StationApp(StationConfig(sessions_dir=tmp_path, sessions_reason="test folder"))
+@pytest.mark.parametrize(
+    "simulator",
+    [("--model", "joints", "--faulty-joint", "3", "--joint-fault", "noise", "--seed", "4")],
+    indirect=True,
+)
+async def test_joint_troubleshooting_through_the_tui(tmp_path: Path, simulator: str, tui) -> None:
+    app = tui_app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await run_procedure(
+            pilot, tui, "joint_troubleshooting", simulator, "1=x,2=y,3=z", "3", lambda _: {}
+        )
+        report = text_of(app, "#summary-report")
+        assert "SUSPECT: joint 3." in report
+        # Wrapped to the summary's column, not cropped at its edge.
+        assert max(len(line) for line in app.screen.view.report.lines) <= 74
+        assert "3 joints" in text_of(app, "#summary-title")
+        view = app.screen.view
+    document = analyze_json(view.path)
+    assert document["suspect"] == 3 and len(document["joints"]) == 3
 
-    def gains(step) -> dict[str, str]:
-        q = -30 + 30 * (step.placement - 1)
-        kp = 2 - 0.03 * q + 4e-4 * q**2 - 1e-6 * q**3
-        return {"q": f"{q:g}", "kp": f"{kp:.9f}", "ki": f"{0.4 + 0.001 * q:.6f}", "kd": "0.07"}
 
-    try:
-        async with app.run_test(size=(80, 24)) as pilot:
-            await set_up(pilot, tui, "gain_schedule", url, "1=q", "6")
-            path = await walk(pilot, tui, gains)
-    finally:
-        simulator.stop()
-    document = analyze_json(path)
-    assert list(document["gains"]) == ["kp", "ki", "kd"]
-    assert document["gains"]["kp"]["order"] == 3
-    assert document["gains"]["ki"]["order"] == 1
+@pytest.mark.parametrize("simulator", [("--channels", "q")], indirect=True)
+async def test_gain_schedule_through_the_tui(tmp_path: Path, simulator: str, tui) -> None:
+    app = tui_app(tmp_path)
+
+    def gains(placement: int) -> dict[str, str]:
+        q = -30 + 15 * (placement - 1)
+        return {"q": str(q), "kp": repr(2 - 0.03 * q + 4e-4 * q * q), "ki": "0.4", "kd": "0.07"}
+
+    async with app.run_test(size=(80, 24)) as pilot:
+        await run_procedure(pilot, tui, "gain_schedule", simulator, "1=q", "5", gains)
+        report = text_of(app, "#summary-report")
+        assert "GAIN SCHEDULE: 5 positions" in report
+        assert "5 positions" in text_of(app, "#summary-title")
+        assert "judges no readings" in text_of(app, "#summary-verdict")
+        view = app.screen.view
+        # The text report exports without a capability analysis.
+        await pilot.press("e")
+        await tui.wait_until(pilot, lambda: app.screen.exported)
+    document = analyze_json(view.path)
+    assert document["gains"]["kp"]["order"] == 2
+    assert document["gains"]["kp"]["coefficients"] == pytest.approx([2, -0.03, 4e-4], rel=1e-6)
+    exported = view.path.with_name(view.path.stem + ".report.txt").read_text()
+    assert exported.startswith("GAIN SCHEDULE REPORT ON") and "kp: order 2" in exported
+
+
+async def test_a_repeatability_summary_names_its_gauge_check(tmp_path: Path, tui) -> None:
+    """A session whose header recorded a passed check: the summary's report block says so."""
+    from station.analysis.gauge_check import gauge_check
+    from station.session.gauge_register import record_check
+    from station.session.journal import SessionWriter
+    from tests.session.conftest import reading_fields, session_header_fields
+
+    today = dt.date.today()
+    study = gauge_check([0.1, 0.1001, 0.0999, 0.1] * 7, 0.1, 0.004, resolution=0.0001)
+    register = Path(os.environ["STATION_GAUGES"])
+    record_check(register, "MIT-0042", study, when=today, port={"url": "loop://", "device": "1"})
+    with SessionWriter.create(tmp_path, session_header_fields()) as writer:
+        for cycle in range(1, 6):
+            writer.append("reading", **reading_fields(cycle))
+        path = writer.path
+    register.unlink()  # the header's snapshot speaks, not the register as it is now
+    app = tui_app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        app.push_screen(SummaryScreen(SummaryView.from_file(path), reviewing=True))
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, SummaryScreen))
+        await pilot.pause()
+        report = text_of(app, "#summary-report")
+    assert f"x: gauge MIT-0042: gauge check passed on {today.isoformat()}" in report
+    assert "y: WARNING: no gauge check covers this channel" in report

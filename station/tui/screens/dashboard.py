@@ -116,6 +116,9 @@ class DashboardScreen(Screen[None]):
 
     BINDINGS = [
         Binding("space", "capture", "Capture"),
+        # Shown only once the cycles step may close (it has its minimum): a cycles step inside
+        # a repeat block (one joint's returns) is followed by the next joint's steps.
+        Binding("g", "go_on", "Go on"),
         Binding("r", "reject", "Reject"),
         Binding("n", "note", "Note"),
         Binding("p", "pause", "Pause"),
@@ -142,6 +145,7 @@ class DashboardScreen(Screen[None]):
         self._action_busy = False
         self._shown_message: Any = None
         self._drawn_once = False
+        self._may_go_on = False
 
     @property
     def busy(self) -> bool:
@@ -154,6 +158,8 @@ class DashboardScreen(Screen[None]):
             return self.live
         if action == "back":
             return not self.live
+        if action == "go_on":
+            return self.live and self._may_go_on
         return True
 
     def compose(self) -> ComposeResult:
@@ -182,6 +188,10 @@ class DashboardScreen(Screen[None]):
 
     def show_state(self, state: RunnerState) -> None:
         """Redraw from a runner snapshot and the live analysis (UI thread)."""
+        may_go_on = state.action.kind == "capture" and state.action.may_confirm
+        if may_go_on != self._may_go_on:
+            self._may_go_on = may_go_on
+            self.refresh_bindings()
         self.draw(DashboardView.from_live(state, self.app.live_analysis(), self.app.session_header))
 
     def show_last_reading(self, state: RunnerState) -> None:
@@ -364,6 +374,13 @@ class DashboardScreen(Screen[None]):
             self._in_thread(runner.resume_capture)
         else:
             self._in_thread(runner.pause)
+
+    def action_go_on(self) -> None:
+        """Close the cycles step (it has its minimum) and go on to the next step."""
+        runner = self.app.runner
+        if not self.live or self.busy or runner is None or not self._may_go_on:
+            return
+        self._in_thread(runner.confirm)
 
     def action_finish(self, force: bool = False) -> None:
         """End the captures and show the verdict (asks when fewer than the minimum cycles)."""

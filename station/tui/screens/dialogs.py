@@ -91,6 +91,7 @@ HELP_TEXT = """\
 
 [b]Capture[/b]  Space capture a cycle · r reject the last cycle (asks why; nothing is deleted)
   n note · p pause / continue · f finish · x y z or Tab choose the axis in the charts
+  g go on to the next step (once the step has its minimum cycles, e.g. the next joint)
   q leave (the session stays resumable)
 
 [b]Strokes[/b]  (linearity) the strokes stream as the robot shuttles A↔B · e end the stroke

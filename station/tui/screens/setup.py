@@ -653,7 +653,12 @@ def count_field(procedure: Procedure) -> CountField:
 
 def judged_channels(procedure: Procedure) -> list[str]:
     """The channels that take limits: all but a stroke step's position channel (the linear
-    scale measures where along the bar, not an error)."""
+    scale measures where along the bar, not an error); none when the procedure's analysis
+    kind judges no spec limits (a gauge check, a gain schedule)."""
+    from station.procedures import analysis_needs
+
+    if not analysis_needs(procedure.analysis).limits:
+        return []
     positions = {s.direction_channel for s in procedure.steps if s.kind == "stroke"}
     return [c for c in procedure.channels if c not in positions]
 

@@ -135,6 +135,9 @@ def verdict_text(view: SummaryView) -> Text:
     """The verdict block: overall, then one line per axis with Cp, Cpk and the reason."""
     analysis = view.analysis
     text = Text()
+    if analysis is None and view.report is not None and not view.report.empty:
+        # A kind that judges no readings (a gain schedule): its report block is the result.
+        return Text("No capability verdict: this procedure judges no readings (its report below).")
     if analysis is None:
         return Text("No accepted cycles: there is nothing to judge yet.", style="bold yellow")
     words = [verdict_word(c.capability) for c in analysis.channels.values()]
