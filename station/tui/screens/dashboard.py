@@ -25,7 +25,7 @@ from station.errors import StationError
 from station.tui.messages import CaptureFinished
 from station.tui.remedies import explained
 from station.tui.text import shown, shown_line
-from station.tui.widgets.alarm_log import AlarmLog, alarm_lines
+from station.tui.widgets.alarm_log import AlarmLog, alarm_lines, recorded_alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.figures import decimals_for
 from station.tui.widgets.histogram import HistogramView, histogram_data
@@ -55,6 +55,11 @@ class DashboardView:
     resolution: float | None = None
     unit: str = ""
     ready_to_finish: bool = False
+    flags: Mapping[str, str] = field(default_factory=dict)
+    """Channel -> "above"/"below" when its last reading is beyond a specification limit."""
+    alarms: tuple[Any, ...] | None = None
+    """The alarms the session recorded (``RecordedAlarm``, with their acknowledgements); None:
+    the log shows the chart's alarms instead (a file without alarm events)."""
 
     @classmethod
     def from_live(
@@ -108,6 +113,8 @@ class DashboardView:
             resolution=header.get("resolution"),
             unit=str(header.get("unit", "")),
             ready_to_finish=ready,
+            flags=out_of_spec_flags(last_cycle.values if last_cycle is not None else {}, header),
+            alarms=tuple(state.alarm_list),
         )
 
 
@@ -120,6 +127,7 @@ class DashboardScreen(Screen[None]):
         Binding("n", "note", "Note"),
         Binding("p", "pause", "Pause"),
         Binding("f", "finish", "Finish"),
+        Binding("a", "alarms", "Alarms"),
         Binding("tab", "next_axis", "Axis", key_display="xyz"),
         Binding("x", "axis('x')", "x", show=False),
         Binding("y", "axis('y')", "y", show=False),
@@ -204,6 +212,7 @@ class DashboardScreen(Screen[None]):
                 decimals=decimals,
                 unit=view.unit,
                 selected=self.selected,
+                flags=view.flags,
             )
         )
         selected = view.analyses.get(self.selected)
@@ -211,7 +220,15 @@ class DashboardScreen(Screen[None]):
         self.query_one(ControlChartView).show(
             chart_data(selected, list(view.cycle_numbers), decimals)
         )
-        self.query_one(AlarmLog).show(alarm_lines(view.analyses, view.cycle_numbers))
+        log = self.query_one(AlarmLog)
+        if view.alarms is not None:
+            log.show(
+                recorded_alarm_lines(view.alarms),
+                open_count=sum(not alarm.acknowledged for alarm in view.alarms),
+                more="a: the full list",
+            )
+        else:
+            log.show(alarm_lines(view.analyses, view.cycle_numbers))
         instruments = self.query_one(InstrumentStatus)
         if self.live:
             instruments.show(view.ports)
@@ -225,6 +242,13 @@ class DashboardScreen(Screen[None]):
                 style = {"error": "bold red", "warning": "yellow"}.get(view.message.level, "green")
                 self._say(view.message.text, style)
         self._drawn_once = True
+
+    def on_screen_resume(self) -> None:
+        """Back from the alarm list or a dialog: draw the newest state."""
+        if self.live and self.is_mounted:
+            state = self.app.current_state()
+            if state is not None:
+                self.show_state(state)
 
     def _say(self, text: str, style: str = "") -> None:
         self.query_one("#dash-message", Static).update(shown(text, style=style))
@@ -380,6 +404,26 @@ class DashboardScreen(Screen[None]):
         except StationError as error:
             self._say(explained(error), "bold red")
 
+    def action_alarms(self) -> None:
+        """The alarm list: every alarm in full, acknowledged with a cause (live) or read."""
+        from station.tui.screens.alarms import AlarmsScreen
+
+        view = self.view
+        alarms = tuple(view.alarms or ()) if view is not None else ()
+        runner = self.app.runner if self.live else None
+        if runner is None:
+            self.app.push_screen(AlarmsScreen(alarms, read_only=True))
+            return
+
+        def acknowledge(request: Any) -> None:
+            runner.acknowledge(
+                request.alarm, request.cause, text=request.text, action=request.action
+            )
+
+        self.app.push_screen(
+            AlarmsScreen(alarms, runner.setup.procedure.causes, acknowledge, in_thread=True)
+        )
+
     def action_help(self) -> None:
         """The keys."""
         from station.tui.screens.dialogs import HelpScreen
@@ -412,6 +456,23 @@ class DashboardScreen(Screen[None]):
         )
 
 
+def out_of_spec_flags(last: Mapping[str, float], header: Mapping[str, Any]) -> dict[str, str]:
+    """Channel -> "above" / "below" for each last reading beyond the session's specification
+    limits (flagged the moment the reading is on disk, before the analysis catches up)."""
+    from station.session.header import header_limits
+
+    flags: dict[str, str] = {}
+    for channel, limits in header_limits(header).items():
+        value = last.get(channel)
+        if value is None:
+            continue
+        if limits.usl is not None and value > limits.usl:
+            flags[channel] = "above"
+        elif limits.lsl is not None and value < limits.lsl:
+            flags[channel] = "below"
+    return flags
+
+
 def session_title(header: Mapping[str, Any]) -> str:
     """``robot R1 · repeatability`` from a session header's fields."""
     procedure = header.get("procedure")
@@ -428,8 +489,9 @@ def review_view(
     resolution: float | None,
     unit: str,
     progress: str,
+    alarms: Sequence[Any] | None = None,
 ) -> DashboardView:
-    """The dashboard of a saved session (read-only)."""
+    """The dashboard of a saved session (read-only); ``alarms``: its recorded alarms."""
     return DashboardView(
         title=title,
         progress=progress,
@@ -439,4 +501,5 @@ def review_view(
         cycle_numbers=tuple(cycle_numbers),
         resolution=resolution,
         unit=unit,
+        alarms=tuple(alarms) if alarms else None,
     )
