@@ -11,35 +11,15 @@ import pytest
 from station.analysis.live import replay_live_alarms
 from station.analysis.report import format_report
 from station.errors import StationError
-from station.instruments.protocols import get_protocol
-from station.instruments.simulator import AxisModel, GaugeSpec, Simulator, fixture_model
 from station.run import Runner
 from station.session.alarms import live_events, recorded_alarms
 from station.session.header import analysis_config
 from station.session.model import load_session
 from station.verdicts import analyze_session_file
 
-from .conftest import CHANNELS, cycles_only_procedure, setup_for
+from .conftest import cycles_only_procedure, setup_for
 
 RECORDED_FIELDS = ("channel", "rule", "rule_name", "points", "cycles", "text", "raised_at", "live")
-
-
-@pytest.fixture
-def warming_robot():
-    """A robot that warms up (x drifts over the whole run) and throws outliers (y)."""
-    model = fixture_model(
-        CHANNELS,
-        axis={
-            "x": AxisModel(noise=0.0002, drift=0.004, drift_tau=60.0),
-            "y": AxisModel(noise=0.0002, outlier_rate=0.12, outlier_size=8.0),
-            "z": AxisModel(noise=0.0002),
-        },
-        gauge=GaugeSpec(resolution=0.0001, unit="in", low=-1.0, high=1.0),
-    )
-    sim = Simulator(get_protocol("mitutoyo"), model, None, seed=11)
-    sim.start_pty()
-    yield sim
-    sim.stop()
 
 
 def capture(runner: Runner, count: int) -> None:
