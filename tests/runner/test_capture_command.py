@@ -378,3 +378,18 @@ def test_capture_prints_alarms_and_asks_their_causes_only_at_a_terminal(warming_
     assert "acknowledged: temperature (cell door open); corrective action: waited 30 min" in (
         " ".join(out.decode().split())
     )
+
+
+def test_capture_summary_of_nine_cycles_is_provisional(simulator, tmp_path):
+    folder = tmp_path / "procedures"
+    folder.mkdir()
+    (folder / "cycles-only.toml").write_bytes(CYCLES_ONLY)
+    done = station(
+        "capture", "--procedure", "cycles-only", "--procedures", str(folder),
+        "--port", simulator.url, "--protocol", "mitutoyo", "--robot", "R9",
+        "--sessions", str(tmp_path / "s"), "--cycles", "9", "--limit", "x=-0.002:0.002",
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    verdicts = [line for line in done.stdout.splitlines() if line.startswith("VERDICT:")]
+    assert verdicts[0].startswith("VERDICT: PROVISIONAL: 9 of 25 readings (Cpk "), verdicts
+    assert not any(" CAPABLE (" in line for line in verdicts)
