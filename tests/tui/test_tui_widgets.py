@@ -164,10 +164,11 @@ def test_stats_table_flags_out_of_spec_and_says_provisional() -> None:
         decimals=decimals_for(RESOLUTION),
         flags={"y": "above", "z": "below"},
     )
-    console = Console(width=80, record=True, color_system=None)
+    console = Console(width=76, record=True, color_system=None)
     console.print(stats_table(rows))
     text = console.export_text()
-    assert all(cell_len(line) <= 80 for line in text.splitlines())
+    assert all(cell_len(line) <= 76 for line in text.splitlines())
+    assert "…" not in text, text  # no figure cut to fit
     assert "+0.00110▲" in text and "-0.00105▼" in text and "+0.00010▲" not in text
     assert "PROVISIONAL: 9 of 25 readings, 16 more before a verdict" in text
     assert "CAPABLE" not in text  # nothing judged from 9 readings

@@ -146,8 +146,8 @@ def verdict_text(view: SummaryView) -> Text:
     text.append(overall, style=VERDICT_STYLES.get(overall.partition(":")[0], ""))
     threshold = analysis.config.threshold
     text.append(
-        f"   (capable when Cpk ≥ {threshold:g}; final from {analysis.config.min_n} readings; "
-        f"unit: {view.unit})\n",
+        f"   (capable when Cpk ≥ {threshold:g}, final from {analysis.config.min_n} readings; "
+        f"unit {view.unit})\n",
         style="dim",
     )
     for name, channel in analysis.channels.items():

@@ -45,9 +45,10 @@ class StatsRows:
 
 def stats_table(rows: StatsRows) -> Table:
     """A compact rich table, at most 78 cells wide for three channels."""
-    table = Table(
-        box=box.SIMPLE_HEAD, padding=(0, 1), collapse_padding=True, pad_edge=False, expand=True
-    )
+    # No padding: the box's column dividers are the one-space gaps, so eleven columns (the
+    # reading's out-of-spec mark, the out count, a PROVISIONAL or NOT CAPABLE word, a Cpk with
+    # four decimals) fit 76 cells without cutting a figure.
+    table = Table(box=box.SIMPLE_HEAD, padding=(0, 0), pad_edge=False, show_edge=False, expand=True)
     table.add_column("", width=3, no_wrap=True)
     for heading in ("reading", "n", "X̄", "σ", "a₁", "range", "Cp", "Cpk", "out"):
         table.add_column(heading, justify="right", no_wrap=True)
