@@ -60,6 +60,8 @@ class DashboardView:
     alarms: tuple[Any, ...] | None = None
     """The alarms the session recorded (``RecordedAlarm``, with their acknowledgements); None:
     the log shows the chart's alarms instead (a file without alarm events)."""
+    no_alarms: str = "alarms: none"
+    """What the log says while there is no alarm (live: when the control limits freeze)."""
 
     @classmethod
     def from_live(
@@ -115,6 +117,7 @@ class DashboardView:
             ready_to_finish=ready,
             flags=out_of_spec_flags(last_cycle.values if last_cycle is not None else {}, header),
             alarms=tuple(state.alarm_list),
+            no_alarms=no_alarms_words(header, len(accepted)),
         )
 
 
@@ -226,6 +229,7 @@ class DashboardScreen(Screen[None]):
                 recorded_alarm_lines(view.alarms),
                 open_count=sum(not alarm.acknowledged for alarm in view.alarms),
                 more="a: the full list",
+                empty=view.no_alarms,
             )
         else:
             log.show(alarm_lines(view.analyses, view.cycle_numbers))
@@ -471,6 +475,20 @@ def out_of_spec_flags(last: Mapping[str, float], header: Mapping[str, Any]) -> d
         elif limits.lsl is not None and value < limits.lsl:
             flags[channel] = "below"
     return flags
+
+
+def no_alarms_words(header: Mapping[str, Any], accepted: int) -> str:
+    """The alarm log's words while there is no alarm: live alarms are judged against control
+    limits that freeze after the header's ``freeze_after`` cycles (or a baseline's), so before
+    that none can come, and the operator is told when they will."""
+    if header.get("baseline"):
+        return "alarms: none (judged against the baseline's control limits)"
+    freeze = header.get("freeze_after")
+    if isinstance(freeze, int) and accepted < freeze:
+        return (
+            f"alarms: none yet: live limits freeze after {freeze} cycles, earlier ones judged then"
+        )
+    return "alarms: none"
 
 
 def session_title(header: Mapping[str, Any]) -> str:

@@ -146,7 +146,7 @@ def verdict_text(view: SummaryView) -> Text:
     text.append(overall, style=VERDICT_STYLES.get(overall.partition(":")[0], ""))
     threshold = analysis.config.threshold
     text.append(
-        f"   (capable when Cpk ≥ {threshold:g}, final from {analysis.config.min_n} readings; "
+        f"   (Cpk ≥ {threshold:g} is capable; final from {analysis.config.min_n} readings; "
         f"unit {view.unit})\n",
         style="dim",
     )

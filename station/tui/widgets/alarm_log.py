@@ -72,15 +72,24 @@ class AlarmLog(Static):
         self._lines: list[str] | None = None
         self.max_shown = 3
 
-    def show(self, lines: list[str], *, open_count: int | None = None, more: str = "") -> None:
+    def show(
+        self,
+        lines: list[str],
+        *,
+        open_count: int | None = None,
+        more: str = "",
+        empty: str = "alarms: none",
+    ) -> None:
         """Show the newest alarms (UI thread only); ``open_count``: how many are not
-        acknowledged yet; ``more``: where the full list is (``a: the full list``)."""
-        if lines == self._lines and (open_count, more) == getattr(self, "_extra", None):
+        acknowledged yet; ``more``: where the full list is (``a: the full list``); ``empty``:
+        what to say while there is none."""
+        extra = (open_count, more, empty)
+        if lines == self._lines and extra == getattr(self, "_extra", None):
             return
         self._lines = list(lines)
-        self._extra = (open_count, more)
+        self._extra = extra
         if not lines:
-            self.update(Text("alarms: none", style="dim"))
+            self.update(Text(empty, style="dim"))
             return
         shown = lines[-self.max_shown :]
         counts = f"{len(lines)}"
