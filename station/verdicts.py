@@ -103,10 +103,6 @@ class LiveVerdict(Protocol):
         """The kind's own result so far (per-stroke straightness...), or None."""
         ...
 
-    def all_alarms(self) -> list[tuple[str, Any]]:
-        """Every alarm of the full analysis so far, as (channel, alarm), oldest first."""
-        ...
-
     def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveVerdict:
         """A fresh live analysis of ``cycles`` keeping what is not a cycle (strokes), or
         taking that from ``session`` when given (resume)."""
@@ -520,13 +516,6 @@ class LiveCycles:
     def result(self) -> Any:
         return None
 
-    def all_alarms(self) -> list[tuple[str, Any]]:
-        return [
-            (channel, alarm)
-            for channel, result in self.live.snapshot().channels.items()
-            for alarm in sorted(result.alarms, key=lambda a: (max(a.points), a.rule))
-        ]
-
     def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveCycles:
         fresh = type(self)(self.config, self.channels, self.header)
         if fresh._monitor is not None and session is not None:
@@ -613,9 +602,6 @@ class LiveStrokes:
         if result is None:
             raise StationError("no whole stroke yet: stream one first.")
         return linearity_summary(result.analysis)
-
-    def all_alarms(self) -> list[tuple[str, Any]]:
-        return []
 
     def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveStrokes:
         fresh = type(self)(self.config, self.channels, self.header)

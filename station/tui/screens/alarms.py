@@ -37,7 +37,7 @@ from station.session.alarms import (
 )
 
 
-def alarm_text(alarm: RecordedAlarm) -> Text:
+def alarm_text(alarm: RecordedAlarm, *, hint: bool = True) -> Text:
     """The full text of one alarm (no markup: every part is plain text): where, the rule in
     words, live or retrospective, the sentence, and its acknowledgement."""
     where = "live" if alarm.live else "retrospective"
@@ -49,15 +49,15 @@ def alarm_text(alarm: RecordedAlarm) -> Text:
     if alarm.acks:
         text.append(f"\nacknowledged: {plain(alarm.acks[-1].describe())}", style="green")
     else:
-        text.append("\nnot acknowledged: press a", style="yellow")
+        text.append("\nnot acknowledged" + (": press a" if hint else ""), style="yellow")
     return text
 
 
 class AlarmItem(ListItem):
     """One alarm of the list."""
 
-    def __init__(self, alarm: RecordedAlarm) -> None:
-        super().__init__(Static(alarm_text(alarm), classes="alarm-text"))
+    def __init__(self, alarm: RecordedAlarm, *, hint: bool = True) -> None:
+        super().__init__(Static(alarm_text(alarm, hint=hint), classes="alarm-text"))
         self.alarm = alarm
 
 
@@ -178,7 +178,9 @@ class AlarmsScreen(Screen[None]):
     def compose(self) -> ComposeResult:
         """Title, the list, the keys."""
         yield Static(self._title(), id="alarm-title")
-        yield ListView(*[AlarmItem(alarm) for alarm in self.alarms], id="alarm-list")
+        yield ListView(
+            *[AlarmItem(alarm, hint=not self.read_only) for alarm in self.alarms], id="alarm-list"
+        )
         yield Footer()
 
     def _title(self) -> Text:
@@ -208,7 +210,7 @@ class AlarmsScreen(Screen[None]):
         view = self.query_one(ListView)
         index = view.index
         view.clear()
-        view.extend(AlarmItem(alarm) for alarm in self.alarms)
+        view.extend(AlarmItem(alarm, hint=not self.read_only) for alarm in self.alarms)
         if self.alarms:
             view.index = min(index or 0, len(self.alarms) - 1)
         self.query_one("#alarm-title", Static).update(self._title())
