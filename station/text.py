@@ -95,6 +95,47 @@ def overall_verdict(words: Iterable[str]) -> str:
     return UNDEFINED
 
 
+PROVISIONAL = "PROVISIONAL"
+
+
+def judged_word(channel: Any) -> str:
+    """A channel analysis' verdict word: its ``verdict`` (PROVISIONAL below the minimum count,
+    see :mod:`station.analysis.verdict`), else :func:`verdict_word` of its capability."""
+    verdict = getattr(channel, "verdict", None)
+    if verdict is not None:
+        return str(verdict.word)
+    return verdict_word(getattr(channel, "capability", None))
+
+
+def judged_label(channel: Any) -> str:
+    """:func:`judged_word` with the count of a provisional verdict (``PROVISIONAL: 9 of 25``)."""
+    verdict = getattr(channel, "verdict", None)
+    return str(verdict.label) if verdict is not None else judged_word(channel)
+
+
+def judged_cpk(channel: Any) -> str:
+    """The Cpk as the verdict reads it: enough decimals that the shown figure and the word
+    never contradict each other (``0.9996`` beside NOT CAPABLE, never ``1.00``); two decimals
+    without a verdict, "-" when undefined."""
+    verdict = getattr(channel, "verdict", None)
+    if verdict is not None and verdict.cpk is not None:
+        return str(verdict.cpk_text)
+    return format_index(getattr(getattr(channel, "capability", None), "cpk", None))
+
+
+def overall_judgement(channels: Iterable[Any]) -> str:
+    """The session's verdict over channel analyses: ``PROVISIONAL: k of n`` while any channel
+    is below the minimum count (k its fewest readings), else :func:`overall_verdict`."""
+    channels = list(channels)
+    provisional = [
+        c.verdict for c in channels if getattr(getattr(c, "verdict", None), "provisional", False)
+    ]
+    if provisional:
+        fewest = min(provisional, key=lambda verdict: verdict.n)
+        return f"{PROVISIONAL}: {fewest.n} of {fewest.min_n}"
+    return overall_verdict(judged_word(c) for c in channels)
+
+
 # -- channel maps -----------------------------------------------------------------------------
 
 

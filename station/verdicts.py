@@ -27,7 +27,7 @@ from station.analysis.linearity import (
     linearity_summary,
     tolerance_from_limits,
 )
-from station.analysis.live import LiveAnalysis
+from station.analysis.live import LiveAnalysis, LiveMonitor, Rejection
 from station.analysis.report import format_accuracy, format_linearity
 from station.analysis.strokes import (
     StrokeProfile,
@@ -38,7 +38,12 @@ from station.analysis.strokes import (
 from station.analysis.summary import Analysis, AnalysisConfig, analyze, to_json
 from station.errors import StationError
 from station.procedures import AnalysisNeeds, discover_procedures, register_analysis_needs
-from station.session.alarms import format_recorded_alarms, recorded_alarms, recorded_alarms_json
+from station.session.alarms import (
+    format_recorded_alarms,
+    live_events,
+    recorded_alarms,
+    recorded_alarms_json,
+)
 from station.session.gauge_register import coverage_fields, gauge_block
 from station.session.header import analysis_config
 from station.session.model import Session, load_session
@@ -106,10 +111,6 @@ class LiveVerdict(Protocol):
 
     def result(self) -> Any:
         """The kind's own result so far (per-stroke straightness...), or None."""
-        ...
-
-    def all_alarms(self) -> list[tuple[str, Any]]:
-        """Every alarm of the full analysis so far, as (channel, alarm), oldest first."""
         ...
 
     def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveVerdict:
@@ -505,37 +506,76 @@ def analyze_session_file(
 
 class LiveCycles:
     """The live analysis of cycles (repeatability, relative accuracy): O(1) per cycle, equal
-    to the batch analysis of the session's readings."""
+    to the batch analysis of the session's readings.
+
+    Its alarms are phase II: judged against control limits frozen after the header's
+    ``freeze_after`` points (or fixed by its ``baseline``), through the same
+    :class:`~station.analysis.live.LiveMonitor` that
+    :func:`~station.analysis.live.replay_live_alarms` runs over a recorded session, so a replay
+    gives exactly the alarms the engine wrote. A rejected cycle leaves the analysis without
+    moving the frozen limits; a resumed session is rebuilt from its journal in order.
+    """
 
     def __init__(
         self, config: AnalysisConfig, channels: Sequence[str], header: Mapping[str, Any]
     ) -> None:
         self.config, self.channels, self.header = config, tuple(channels), header
-        self._live = LiveAnalysis(config, self.channels)
+        self._monitor: LiveMonitor | None = None
+        if config.freeze_after is None and config.baseline is None:
+            # No phase II asked for: the limits move with every reading (phase I only).
+            self._live = LiveAnalysis(config, self.channels)
+        else:
+            self._monitor = LiveMonitor(
+                config,
+                self.channels,
+                freeze_after=config.freeze_after,
+                baseline=config.baseline,
+            )
+
+    @property
+    def live(self) -> LiveAnalysis:
+        """The running analysis (the monitor's, when the limits freeze)."""
+        return self._live if self._monitor is None else self._monitor.live
 
     def add_cycle(
         self, values: Mapping[str, float], cycle: int, times: Mapping[str, float] | None = None
     ) -> Mapping[str, Any]:
-        return self._live.add_set(values, cycle, times)
+        if self._monitor is None:
+            return self._live.add_set(values, cycle, times)
+        updates, new = self._monitor.add_set(values, cycle, times)
+        # Only the alarms that are new: a run growing by a point is the alarm already raised.
+        return {
+            channel: replace(update, alarms=tuple(a.alarm for a in new if a.channel == channel))
+            for channel, update in updates.items()
+        }
 
     def add_stroke(self, outcome: Any) -> None:
         return None
 
     def snapshot(self) -> Analysis:
-        return self._live.snapshot()
+        return self.live.snapshot()
 
     def result(self) -> Any:
         return None
 
-    def all_alarms(self) -> list[tuple[str, Any]]:
-        return [
-            (channel, alarm)
-            for channel, result in self._live.snapshot().channels.items()
-            for alarm in sorted(result.alarms, key=lambda a: (max(a.points), a.rule))
-        ]
-
     def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveCycles:
         fresh = type(self)(self.config, self.channels, self.header)
+        if fresh._monitor is not None and session is not None:
+            # Resume: the journal's readings and rejections in order, as they happened.
+            for event in live_events(session):
+                if isinstance(event, Rejection):
+                    fresh._monitor.reject(event.cycle)
+                else:
+                    fresh._monitor.add_set(event.values, event.cycle, event.times)
+            return fresh
+        if fresh._monitor is not None and self._monitor is not None:
+            # A reject: the frozen limits and the alarms already raised stay as they are.
+            kept = {int(number) for _, number, *_ in cycles}
+            for number in self._monitor.accepted_cycles:
+                if number not in kept:
+                    self._monitor.reject(number)
+            fresh._monitor = self._monitor
+            return fresh
         for values, number, *times in cycles:
             fresh.add_cycle(values, number, times[0] if times else None)
         return fresh
@@ -604,9 +644,6 @@ class LiveStrokes:
         if result is None:
             raise StationError("no whole stroke yet: stream one first.")
         return linearity_summary(result.analysis)
-
-    def all_alarms(self) -> list[tuple[str, Any]]:
-        return []
 
     def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveStrokes:
         fresh = type(self)(self.config, self.channels, self.header)

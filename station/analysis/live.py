@@ -200,6 +200,11 @@ class LiveMonitor:
         for reading_set in self._accepted:
             self.live.add_set(reading_set.values, reading_set.cycle, reading_set.times)
 
+    @property
+    def accepted_cycles(self) -> tuple[int, ...]:
+        """The cycle numbers the analysis holds now (added and not rejected), in order."""
+        return tuple(reading_set.cycle for reading_set in self._accepted)
+
     def frozen_limits(self) -> dict[str, FrozenLimits]:
         """The phase II limits of each channel that has them."""
         return {

@@ -608,6 +608,14 @@ class _Printer:
         elif kind == "zero":
             zeroed = ", ".join(f"{ch} ({spec['method']})" for ch, spec in event["channels"].items())
             self._print(f"zeroed {zeroed}")
+        elif kind == "alarm":
+            from station.session.alarms import recorded_alarm
+
+            self._print(alarm_line(recorded_alarm(event)))
+            # The engine's warning about the same alarm says nothing new: not repeated.
+            self._last_warning = f"{event['channel']}: {event.get('rule_name')}: {event['text']}"
+        elif kind == "ack":
+            self._print(f"alarm #{event['alarm']} acknowledged: {event['cause']}")
         elif (
             notice.message is not None
             and notice.message.level == "info"
@@ -625,6 +633,73 @@ class _Printer:
     def _print(self, line: str) -> None:
         print(line, flush=True)
         self._last_warning = None
+
+
+def alarm_line(alarm: Any) -> str:
+    """A recorded alarm (:class:`~station.session.alarms.RecordedAlarm`) as ``station capture``
+    prints it: ``alarm #41 y, report rule 1 (a point beyond the control limits) [live]:
+    <sentence>``."""
+    where = "live" if alarm.live else "retrospective"
+    return f"alarm #{alarm.seq} {alarm.channel}, {alarm.rule_name} [{where}]: {alarm.text}"
+
+
+def acknowledge_at_terminal(
+    runner: Any, stdin: Any = None, out: Any = None, stop: Any = lambda: False
+) -> int:
+    """Ask, on a terminal only, for the cause of each alarm not acknowledged yet (before the
+    session is finished, while its file takes events): the cause from the procedure's list
+    (Enter leaves the alarm as it is), what it was ("other" needs it) and the corrective
+    action. Returns how many were acknowledged. Without a terminal on stdin nothing is asked,
+    so a script is never blocked; end of input or ``stop()`` (a signal caught) ends the
+    questions."""
+    import select
+
+    stdin = sys.stdin if stdin is None else stdin
+    out = sys.stdout if out is None else out
+    if not stdin.isatty():
+        return 0
+    pending = [alarm for alarm in runner.state().alarm_list if not alarm.acknowledged]
+    if not pending:
+        return 0
+    causes = tuple(runner.setup.procedure.causes)
+    print(
+        f"{len(pending)} alarm{'s' if len(pending) > 1 else ''} not acknowledged. For each, "
+        f"type its cause ({', '.join(causes)}), or press Enter to leave it unacknowledged.",
+        file=out,
+        flush=True,
+    )
+
+    def ask(prompt: str) -> str | None:
+        print(prompt, end="", file=out, flush=True)
+        # Wait in short steps: a signal (Ctrl-C) is only recorded by the command's handler,
+        # and must still end the questions.
+        while not select.select([stdin], [], [], 0.1)[0]:
+            if stop():
+                return None
+        line = stdin.readline()
+        return None if not line or stop() else line.strip()
+
+    done = 0
+    for alarm in pending:
+        print(alarm_line(alarm), file=out, flush=True)
+        while True:
+            cause = ask("  cause: ")
+            if cause is None:
+                return done  # end of input: the rest stay unacknowledged
+            if not cause:
+                break
+            text = ask("  what it was (needed for 'other'; Enter: nothing): ")
+            action = None if text is None else ask("  corrective action (Enter: none): ")
+            if text is None or action is None:
+                return done
+            try:
+                runner.acknowledge(alarm.seq, cause, text=text, action=action, by=BY)
+            except StationError as error:
+                print(f"  {error.message}", file=out, flush=True)
+                continue
+            done += 1
+            break
+    return done
 
 
 def _check_units(gauges: Any, setup: Any, timeout: float, resume: str | None) -> None:
@@ -727,6 +802,12 @@ def run(args: argparse.Namespace) -> int:
         while not headless.done.wait(0.05):
             if caught:
                 break
+        if not caught:
+            return_code = _ended(runner, headless)
+            if return_code is not None:
+                return return_code
+            # Only at a terminal (the operator is there): the alarms' causes, before the finish.
+            acknowledge_at_terminal(runner, stop=lambda: bool(caught))
         if caught:
             signum = caught[0]
             name = signal.Signals(signum).name
@@ -739,9 +820,6 @@ def run(args: argparse.Namespace) -> int:
                 file=sys.stderr,
             )
             return 128 + signum
-        return_code = _ended(runner, headless)
-        if return_code is not None:
-            return return_code
         analysis = runner.finish(by=BY)
     finally:
         if gauges is not None:
@@ -813,6 +891,6 @@ def _print_summary(runner: Any, analysis: Any) -> None:
             f"Session file: {runner.path}",
             f"Last line hash (anchors the session file): {runner.last_hash}",
         ]
-        print(report.text(notes, alarms=False), end="")
+        print(report.text(notes, alarms=True), end="")
     print(f"session file: {Path(runner.path)}")
     print(f"last hash: {runner.last_hash}")

@@ -18,8 +18,9 @@ from datetime import datetime
 from typing import Any
 
 from station.analysis.report import decimals_for as report_decimals
+from station.analysis.rules import rule_name
 from station.record.source import AnalysedSession
-from station.text import NOT_AVAILABLE, format_value, verdict_word
+from station.text import NOT_AVAILABLE, format_value, judged_cpk, judged_label
 
 MISSING = NOT_AVAILABLE
 """What an absent or undefined figure shows (the same ``-`` as every screen and command)."""
@@ -375,10 +376,10 @@ def _verdicts(analysed: AnalysedSession, resolution: float | None) -> tuple[Verd
                 mean=number(channel.descriptive.mean, places, signed=True),
                 sd=number(channel.descriptive.sd, places),
                 cp=index(cap.cp),
-                cpk=index(cap.cpk),
+                cpk=judged_cpk(channel),
                 cpk_lower=index(cap.cpk_lower),
                 confidence=f"{cap.confidence:.0%}",
-                word=verdict_word(cap),
+                word=judged_label(channel),
                 message=str(cap.message or ""),
             )
         )
@@ -424,7 +425,10 @@ def build_content(analysed: AnalysedSession) -> ReportContent:
         AlarmLine(
             time=short_time(alarm["t"]),
             channel=str(alarm.get("channel") or ""),
-            rule=str(alarm.get("rule") or ""),
+            # The rule in words, and whether it was raised live (all alarm events are, since
+            # the live limits froze; a file may still mark one retrospective).
+            rule=f"{rule_name(str(alarm.get('rule') or ''))} "
+            f"[{'live' if alarm.get('live', True) else 'retrospective'}]",
             cycles=", ".join(str(c) for c in alarm.get("cycles") or ()) or MISSING,
             text=str(alarm.get("text") or ""),
             acknowledged=acknowledgement_of(alarm, acks),

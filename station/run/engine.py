@@ -13,10 +13,17 @@ branch. Its rules:
   (:class:`~station.run.state.RunnerNotice`): a display never takes the engine's lock.
 * Cycles are numbered 1, 2, ... over the whole session; a rejected cycle keeps its number
   (readings are never deleted), a resumed session continues the numbering.
-* Alarms of the live analysis are written as ``alarm`` events when they first appear; an alarm
-  is new unless it flags a cycle an alarm of the same rule and channel already flagged (a run
-  growing by a point is one alarm). The full analysis' alarms are checked when a set-taking
-  step closes and before the finish.
+* Alarms of the live analysis are written as ``alarm`` events (``live`` true, the rule named
+  in words) when they first appear; an alarm is new unless it flags a cycle an alarm of the
+  same rule and channel already flagged (a run growing by a point is one alarm). The live
+  analysis judges against frozen (phase II) limits, so a written alarm never goes away, and a
+  replay of the file (:func:`~station.analysis.live.replay_live_alarms`) gives exactly the
+  alarm events written. The retrospective chart (limits from every reading) is not
+  journalled: it is a function of the readings, and the reports compute it and mark each of
+  its alarms live or retrospective.
+* :meth:`Runner.acknowledge` writes an ``ack`` event naming an alarm event with a cause from
+  the procedure's list; the state carries every alarm with its acknowledgements
+  (:attr:`~station.run.state.RunnerState.alarm_list`).
 
 Threads: every public method may be called from any thread. A lock serialises journal writes
 and state changes; blocking waits on the instruments happen outside it, so :meth:`interrupt`
@@ -45,6 +52,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 from station import verdicts
+from station.analysis.rules import rule_name
 from station.errors import StationError
 from station.instruments.gauge import unit_mismatch
 from station.run.setup import SessionSetup, resume_setup, unroll
@@ -65,6 +73,13 @@ from station.run.state import (
 )
 from station.run.steps import handler_for
 from station.run.steps.base import PlanItem, StepHandler
+from station.session.alarms import (
+    RecordedAlarm,
+    ack_fields,
+    acknowledgement,
+    recorded_alarm,
+    recorded_alarms,
+)
 from station.session.header import analysis_config
 from station.session.journal import SessionWriter
 from station.session.model import Session, event_seconds
@@ -164,6 +179,7 @@ class Runner:
         self._messages: deque[OperatorMessage] = deque(maxlen=_MESSAGES_KEPT)
         self._alarm_count = 0
         self._alarm_flagged: dict[tuple[str, str], set[int]] = {}
+        self._alarm_list: tuple[RecordedAlarm, ...] = ()
         self._port_states: dict[str, str] = {}
         self.header: Mapping[str, Any] = writer.snapshot().header
         self.config = analysis_config(self.header)
@@ -276,6 +292,7 @@ class Runner:
                     )
                 )
             self._next_cycle = session.next_cycle
+            self._alarm_list = recorded_alarms(session)
             self._rebuild_live(session)
             self._views = ()
 
@@ -459,6 +476,47 @@ class Runner:
             self._notify(self._last_event, analysis=True)
             return record.cycle
 
+    def acknowledge(
+        self,
+        alarm_ref: int,
+        cause: str,
+        text: str | None = None,
+        action: str | None = None,
+        by: str = "operator",
+    ) -> RecordedAlarm:
+        """Acknowledge the alarm event whose ``seq`` is ``alarm_ref`` with ``cause`` (one of
+        the procedure's causes; "other" needs ``text``) and the corrective ``action``: an
+        ``ack`` event, fsynced. Returns the alarm with its acknowledgements. StationError for
+        an unknown alarm or cause, or a closed file."""
+        with self.lock:
+            self.ensure_open()
+            index = next(
+                (i for i, alarm in enumerate(self._alarm_list) if alarm.seq == alarm_ref), None
+            )
+            if index is None:
+                known = ", ".join(f"#{alarm.seq}" for alarm in self._alarm_list) or "none yet"
+                raise StationError(
+                    f"there is no alarm #{alarm_ref} in this session (alarms: {known})"
+                )
+            fields = ack_fields(
+                alarm_ref,
+                cause,
+                causes=self.setup.procedure.causes,
+                text=text or "",
+                action=action or "",
+                by=by,
+            )
+            event = self.append("ack", **fields)
+            alarm = self._alarm_list[index]
+            acknowledged = replace(alarm, acks=(*alarm.acks, acknowledgement(event)))
+            alarms = list(self._alarm_list)
+            alarms[index] = acknowledged
+            self._alarm_list = tuple(alarms)
+            self.say(
+                "info", f"Alarm #{alarm_ref} acknowledged: {acknowledged.acks[-1].describe()}."
+            )
+            return acknowledged
+
     def note(self, text: str, by: str = "operator") -> None:
         """Record the operator's note."""
         text = text.strip()
@@ -499,7 +557,6 @@ class Runner:
                 if action.may_confirm and not self.busy:
                     handler.confirm(self, item, by)
             complete = self._position >= len(self._plan)
-            self.record_snapshot_alarms()
             self.append(
                 "finish",
                 by=by,
@@ -609,6 +666,7 @@ class Runner:
                 messages=tuple(self._messages),
                 last_hash=self.last_hash,
                 alarms=self._alarm_count,
+                alarm_list=self._alarm_list,
                 failure=self._failure or "",
             )
 
@@ -780,7 +838,7 @@ class Runner:
         # Acknowledged: the listener hears of the reading as soon as it is on disk, with the
         # state that includes it (the last-reading line); the live figures and alarms follow.
         self._notify(self._last_event)
-        self._record_alarms(self._live.add_cycle(record.values, number, record.times))
+        self._record_alarms(self._live.add_cycle(record.values, number, record.times), number)
         self._notify(None, analysis=True)
         return CycleOutcome(recorded=True, message=record.line(), cycle=record)
 
@@ -829,14 +887,6 @@ class Runner:
         message = OperatorMessage(level, text)
         self._messages.append(message)
         self._tell(RunnerNotice(None, self.state(), message))
-
-    def record_snapshot_alarms(self) -> None:
-        """Write the full analysis' alarms that are new (a pattern the limits as they are now
-        show over earlier points)."""
-        if not self._accepted_count:
-            return
-        for channel, alarm in self._live.all_alarms():
-            self._record_alarm(channel, alarm)
 
     # -- internals --------------------------------------------------------------------------
 
@@ -890,14 +940,14 @@ class Runner:
             for reader in getattr(self.gauges, "readers", ())
         )
 
-    def _record_alarms(self, updates: Mapping[str, Any]) -> None:
-        """Write ``alarm`` events for the alarms a new cycle raised (the windows it completes,
-        O(1))."""
+    def _record_alarms(self, updates: Mapping[str, Any], raised_at: int) -> None:
+        """Write ``alarm`` events for the alarms cycle ``raised_at`` raised (the windows it
+        completes, O(1))."""
         for channel, update in updates.items():
             for alarm in update.alarms:
-                self._record_alarm(channel, alarm)
+                self._record_alarm(channel, alarm, raised_at)
 
-    def _record_alarm(self, channel: str, alarm: Any) -> None:
+    def _record_alarm(self, channel: str, alarm: Any, raised_at: int) -> None:
         # The live analysis is fed each set with its cycle number: its alarms name cycles.
         cycles = list(alarm.cycles)
         if not cycles:
@@ -907,16 +957,21 @@ class Runner:
         flagged.update(cycles)
         if known:
             return
-        self.append(
+        # The fields of LiveAlarm.event_fields: what a replay of the file gives back.
+        event = self.append(
             "alarm",
             channel=channel,
             rule=alarm.rule,
+            rule_name=rule_name(alarm.rule),
             points=list(alarm.points),
             cycles=cycles,
             text=alarm.text,
+            raised_at=raised_at,
+            live=True,
         )
         self._alarm_count += 1
-        self.say("warning", f"{channel}: {alarm.text}")
+        self._alarm_list = (*self._alarm_list, recorded_alarm(event))
+        self.say("warning", f"{channel}: {rule_name(alarm.rule)}: {alarm.text}")
 
     def _close(self) -> None:
         """Close the file and let go of the gauges (the subscription is cancelled, so a gauge

@@ -17,6 +17,7 @@ from station.text import format_value
 
 if TYPE_CHECKING:
     from station.procedures import InputField, Step
+    from station.session.alarms import RecordedAlarm
 
 StepMark = Literal["done", "current", "pending"]
 
@@ -208,6 +209,9 @@ class RunnerState:
     last_hash: str
     alarms: int
     """How many ``alarm`` events are in the file."""
+    alarm_list: tuple[RecordedAlarm, ...] = ()
+    """Every ``alarm`` event in the file, oldest first, with its acknowledgements (the alarm
+    list reads them here, never through the engine's lock)."""
     failure: str = ""
     """Why the session failed (status ``failed``: a write failed, e.g. the disk is full);
     empty otherwise."""

@@ -117,7 +117,8 @@ def ack_fields(
     return fields
 
 
-def _acknowledgement(event: Any) -> Acknowledgement:
+def acknowledgement(event: Any) -> Acknowledgement:
+    """One ``ack`` event (a journal line's mapping) as an :class:`Acknowledgement`."""
     return Acknowledgement(
         seq=int(event["seq"]),
         alarm=int(event["alarm"]),
@@ -129,31 +130,31 @@ def _acknowledgement(event: Any) -> Acknowledgement:
     )
 
 
-def recorded_alarms(session: Session) -> tuple[RecordedAlarm, ...]:
-    """Every alarm event of the session in order, with its acknowledgements."""
+def recorded_alarm(event: Any, acks: Sequence[Acknowledgement] = ()) -> RecordedAlarm:
+    """One ``alarm`` event (a journal line's mapping) with the acknowledgements naming it."""
     from station.analysis.rules import rule_name
 
+    rule = str(event.get("rule") or "")
+    return RecordedAlarm(
+        seq=int(event["seq"]),
+        channel=str(event.get("channel") or ""),
+        rule=rule,
+        rule_name=str(event.get("rule_name") or rule_name(rule)),
+        text=str(event.get("text") or ""),
+        cycles=tuple(int(c) for c in event.get("cycles") or () if isinstance(c, int)),
+        live=bool(event.get("live", True)),
+        t=str(event.get("t") or ""),
+        acks=tuple(acks),
+    )
+
+
+def recorded_alarms(session: Session) -> tuple[RecordedAlarm, ...]:
+    """Every alarm event of the session in order, with its acknowledgements."""
     acks: dict[int, list[Acknowledgement]] = {}
     for event in session.acks:
-        ack = _acknowledgement(event)
+        ack = acknowledgement(event)
         acks.setdefault(ack.alarm, []).append(ack)
-    found = []
-    for event in session.alarms:
-        rule = str(event.get("rule") or "")
-        found.append(
-            RecordedAlarm(
-                seq=int(event["seq"]),
-                channel=str(event.get("channel") or ""),
-                rule=rule,
-                rule_name=str(event.get("rule_name") or rule_name(rule)),
-                text=str(event.get("text") or ""),
-                cycles=tuple(int(c) for c in event.get("cycles") or () if isinstance(c, int)),
-                live=bool(event.get("live", True)),
-                t=str(event.get("t") or ""),
-                acks=tuple(acks.get(int(event["seq"]), ())),
-            )
-        )
-    return tuple(found)
+    return tuple(recorded_alarm(event, acks.get(int(event["seq"]), ())) for event in session.alarms)
 
 
 def live_events(session: Session) -> list[ReadingSet | Rejection]:

@@ -402,7 +402,7 @@ class StationApp(App[int]):
 
         if state.status in ("finished", "interrupted", "failed"):
             return False
-        screen = self.screen
+        screen = self._run_screen()
         action = state.action.kind
         if action == "stream":
             from station.tui.screens.strokes import StrokeDashboardScreen
@@ -422,11 +422,25 @@ class StationApp(App[int]):
             return True
         return False
 
+    def _run_screen(self) -> Any:
+        """The screen the session runs on, under any dialog or the alarm list opened over it
+        (those stay open while the run screen is still the right one)."""
+        from textual.screen import ModalScreen
+
+        from station.tui.screens.alarms import AlarmsScreen
+
+        for screen in reversed(self.screen_stack):
+            if not isinstance(screen, ModalScreen | AlarmsScreen):
+                return screen
+        return self.screen
+
     def _replace_run_screen(self, screen: Any) -> None:
         """Swap the set-up, checklist or dashboard for ``screen`` (modals are closed first)."""
         from textual.screen import ModalScreen
 
-        while isinstance(self.screen, ModalScreen):
+        from station.tui.screens.alarms import AlarmsScreen
+
+        while isinstance(self.screen, ModalScreen | AlarmsScreen):
             self.pop_screen()
         self.switch_screen(screen)
 

@@ -171,10 +171,11 @@ def test_autopilot_demo_of_each_procedure_reaches_its_verdict(
         lines = [line.strip() for line in screen.splitlines()]
         verdict_lines = [line for line in lines if line[:2] in channels]
         assert len(verdict_lines) == len(channels), screen
+        # The demo's short count is below the procedure's minimum: provisional, with the count.
         for line in verdict_lines:
-            assert "CAPABLE" in line or "UNDEFINED" in line, line
+            assert f"PROVISIONAL: {count} of " in line or "UNDEFINED" in line, line
         verdict = next(line for line in lines if line.startswith("Verdict:"))
-        assert verdict.split()[1] in ("CAPABLE", "NOT", "UNDEFINED"), verdict
+        assert verdict.startswith(f"Verdict: PROVISIONAL: {count} of "), verdict
         sessions = list((tmp_path / "demo").glob("*.jsonl"))
         assert len(sessions) == 1
         verify = subprocess.run(

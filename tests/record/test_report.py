@@ -284,3 +284,27 @@ def test_report_of_a_real_headless_capture(tmp_path):
     for fmt, text in texts.items():
         missing = [f for f in (" ".join(f.split()) for f in facts(content)) if f not in text]
         assert missing == [], f"{fmt} lacks {missing[:5]}"
+
+
+def test_the_text_report_names_rules_in_words_with_acks_and_a_provisional_verdict(tmp_path):
+    from station.session.alarms import ack_fields
+    from station.session.journal import SessionWriter
+    from station.session.model import load_session
+
+    path = write_repeatability(tmp_path / "s", cycles=9, reject=None)
+    # Acknowledged before the finish, as the engine does: the finish line goes, the ack and a
+    # new finish follow (the earlier lines' chain is untouched).
+    lines = path.read_bytes().splitlines(keepends=True)
+    path.write_bytes(b"".join(lines[:-1]))
+    (alarm,) = load_session(path).alarms
+    writer, _ = SessionWriter.resume(path)
+    with writer:
+        writer.append(
+            "ack", **ack_fields(alarm["seq"], "gauge", action="re-clamped the x indicator")
+        )
+        writer.append("finish", by="operator", complete=True, accepted=9, rejected=[])
+    text = " ".join(render_report(path, "txt").split())
+    assert "report rule 1 (a point beyond the control limits) [live]" in text
+    assert "acknowledged: gauge; re-clamped the x indicator" in text
+    assert "PROVISIONAL: 9 of 25" in text
+    assert " CAPABLE" not in text.replace("NOT CAPABLE", "")

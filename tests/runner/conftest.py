@@ -57,6 +57,25 @@ def gauges_for() -> Iterator[Callable[..., object]]:
         gauges.stop()
 
 
+@pytest.fixture
+def warming_robot() -> Iterator[Simulator]:
+    """A robot that warms up (x drifts over the whole run) and throws outliers (y): live
+    alarms are sure to come (polled, on a pty)."""
+    model = fixture_model(
+        CHANNELS,
+        axis={
+            "x": AxisModel(noise=0.0002, drift=0.004, drift_tau=60.0),
+            "y": AxisModel(noise=0.0002, outlier_rate=0.12, outlier_size=8.0),
+            "z": AxisModel(noise=0.0002),
+        },
+        gauge=GaugeSpec(resolution=0.0001, unit="in", low=-1.0, high=1.0),
+    )
+    sim = Simulator(get_protocol("mitutoyo"), model, None, seed=11)
+    sim.start_pty()
+    yield sim
+    sim.stop()
+
+
 def setup_for(
     url: str,
     procedure: Procedure | None = None,

@@ -24,6 +24,7 @@ def station(*args: str, timeout: float = 60) -> subprocess.CompletedProcess[str]
     """Run ``station`` in a subprocess (no site procedures from the environment)."""
     return subprocess.run(
         [sys.executable, "-m", "station", *args],
+        stdin=subprocess.DEVNULL,  # a script: never a terminal to ask an alarm's cause at
         capture_output=True,
         text=True,
         cwd=REPO,
@@ -300,3 +301,95 @@ def test_capture_help_fits_80_columns():
     )  # fmt: skip
     assert done.returncode == 0
     assert max(len(line) for line in done.stdout.splitlines()) <= 79, done.stdout
+
+
+def _read_until(stream, marker: str, timeout: float = 60.0) -> str:
+    """What ``stream`` (a pipe's fd) gives until ``marker`` appears."""
+    import select
+    import time
+
+    seen = b""
+    deadline = time.monotonic() + timeout
+    while marker.encode() not in seen:
+        left = deadline - time.monotonic()
+        assert left > 0, f"no {marker!r} in: {seen.decode(errors='replace')}"
+        if select.select([stream], [], [], left)[0]:
+            chunk = os.read(stream.fileno(), 65536)
+            assert chunk, f"the command ended before {marker!r}: {seen.decode()}"
+            seen += chunk
+    return seen.decode()
+
+
+def test_capture_prints_alarms_and_asks_their_causes_only_at_a_terminal(warming_robot, tmp_path):
+    import pty
+
+    folder = tmp_path / "procedures"
+    folder.mkdir()
+    (folder / "cycles-only.toml").write_bytes(CYCLES_ONLY)
+    arguments = [
+        sys.executable, "-m", "station", "capture", "--procedure", "cycles-only",
+        "--procedures", str(folder), "--port", warming_robot.url, "--protocol", "mitutoyo",
+        "--robot", "R7", "--sessions", str(tmp_path / "s"), "--cycles", "40",
+    ]  # fmt: skip
+    env = {**os.environ, "STATION_PROCEDURES": ""}
+
+    # A script (no terminal on stdin): the alarms are printed as they are written, nothing
+    # is asked, the session finishes.
+    script = subprocess.run(
+        arguments, stdin=subprocess.DEVNULL, capture_output=True, text=True, cwd=REPO,
+        env=env, timeout=120,
+    )  # fmt: skip
+    assert script.returncode == 0, script.stderr
+    printed = [line for line in script.stdout.splitlines() if line.startswith("alarm #")]
+    assert printed and "[live]:" in printed[0] and "rule" in printed[0]
+    assert "not acknowledged. For each" not in script.stdout
+    session = load_session(Path(script.stdout.splitlines()[-2].split(": ", 1)[1]))
+    assert len(printed) == len(session.alarms) and not session.acks
+    # Each printed as soon as written: after the cycle that raised it, before the next one.
+    lines = script.stdout.splitlines()
+    first = session.alarms[0]
+    at = lines.index(printed[0])
+    assert lines[at - 1].startswith(f"cycle {first['raised_at']} ")
+    assert "ALARMS RECORDED DURING THE SESSION" in script.stdout  # the summary lists them
+
+    # At a terminal: one question per alarm; the first gets a cause, the rest are left.
+    master, slave = pty.openpty()
+    process = subprocess.Popen(
+        arguments, stdin=slave, stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=REPO,
+        env=env,
+    )  # fmt: skip
+    os.close(slave)
+    try:
+        _read_until(process.stdout, "  cause: ")
+        os.write(master, b"coffee\n\n\n")  # not one of the causes: said, and asked again
+        _read_until(process.stdout, "not one of the procedure's causes")
+        os.write(master, b"temperature\ncell door open\nwaited 30 min\n" + b"\n" * 200)
+        out, err = process.communicate(timeout=120)
+    finally:
+        os.close(master)
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == 0, err.decode()
+    path = Path(out.decode().splitlines()[-2].split(": ", 1)[1])
+    session = load_session(path)
+    (ack,) = session.acks
+    assert ack["cause"] == "temperature" and ack["action"] == "waited 30 min"
+    assert ack["alarm"] == session.alarms[0]["seq"] and ack["by"] == "station capture"
+    assert "acknowledged: temperature (cell door open); corrective action: waited 30 min" in (
+        " ".join(out.decode().split())
+    )
+
+
+def test_capture_summary_of_nine_cycles_is_provisional(simulator, tmp_path):
+    folder = tmp_path / "procedures"
+    folder.mkdir()
+    (folder / "cycles-only.toml").write_bytes(CYCLES_ONLY)
+    done = station(
+        "capture", "--procedure", "cycles-only", "--procedures", str(folder),
+        "--port", simulator.url, "--protocol", "mitutoyo", "--robot", "R9",
+        "--sessions", str(tmp_path / "s"), "--cycles", "9", "--limit", "x=-0.002:0.002",
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    verdicts = [line for line in done.stdout.splitlines() if line.startswith("VERDICT:")]
+    assert verdicts[0].startswith("VERDICT: PROVISIONAL: 9 of 25 readings (Cpk "), verdicts
+    assert not any(" CAPABLE (" in line for line in verdicts)

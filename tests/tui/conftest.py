@@ -55,11 +55,15 @@ async def walk_checklist(pilot) -> int:
     app = pilot.app
     await wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen | DashboardScreen))
     done = 0
-    while not isinstance(app.screen, DashboardScreen):
+    # Ask the runner, not the screen: the screen follows the runner's state at the next redraw,
+    # and an Enter pressed in between would land on the dashboard and confirm nothing.
+    while app.runner.state().action.kind in ("confirm", "input", "zero"):
+        await wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen))
         before = app.runner.state().current.index
         await pilot.press("enter")
         await wait_until(pilot, lambda before=before: app.runner.state().current.index != before)
         done += 1
+    await wait_until(pilot, lambda: isinstance(app.screen, DashboardScreen))
     await pilot.pause()
     return done
 

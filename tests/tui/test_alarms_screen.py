@@ -91,3 +91,18 @@ async def test_other_needs_a_text_and_escape_cancels():
         await pilot.press("escape")
         await pilot.pause()
         assert isinstance(app.screen, AlarmsScreen) and app.requests == []
+
+
+async def test_a_recorded_sessions_list_is_read_only():
+    class ReadOnly(App):
+        def on_mount(self) -> None:
+            self.push_screen(AlarmsScreen(alarms(), read_only=True))
+
+    app = ReadOnly()
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        await pilot.press("a")
+        await pilot.pause()
+        assert isinstance(app.screen, AlarmsScreen)
+        text = screen_text(app)
+        assert "not acknowledged" in text and "press a" not in text

@@ -1,8 +1,10 @@
 """A whole repeatability session through the TUI at 80×24, by keyboard, against the simulator.
 
 Set-up (a bad limit refused with a sentence next to its field), the checklist, 30 cycles with a
-reject and its reason, an alarm in the log, finish, the summary; then the session file verifies
-with ``station verify`` and ``station analyze --json`` on it equals the analysis the TUI showed.
+reject and its reason, an alarm in the log with its rule in words, acknowledged with a cause on
+the alarm list, finish, the summary (the acknowledgement in it and in the exported text
+report); then the session file verifies with ``station verify`` and ``station analyze --json``
+on it equals the analysis the TUI showed.
 """
 
 from __future__ import annotations
@@ -13,11 +15,12 @@ import subprocess
 import sys
 from pathlib import Path
 
-from textual.widgets import Input, Static
+from textual.widgets import Footer, Input, Static
 
 from station.analysis.summary import to_json
 from station.session.model import load_session
 from station.tui.app import StationApp, StationConfig
+from station.tui.screens.alarms import AckDialog, AlarmsScreen
 from station.tui.screens.dashboard import DashboardScreen
 from station.tui.screens.home import HomeScreen
 from station.tui.screens.setup import SetupScreen
@@ -95,7 +98,33 @@ async def test_full_repeatability_session(tmp_path: Path, fixture_pty, tui) -> N
         await pilot.pause(0.3)  # one redraw
         assert "cycle 30 of 30" in _text(app, "#dash-title")
         alarms = str(app.screen.query_one(AlarmLog).render())
-        assert "[report-" in alarms and "cycle " in alarms, alarms
+        assert "report rule 1 (a point beyond the control limits)" in alarms, alarms
+        assert "not acknowledged" in alarms and "a: the full list" in alarms
+        footer_keys = {
+            key.key: key.description for key in app.screen.query_one(Footer).query("FooterKey")
+        }
+        assert footer_keys.get("a") == "Alarms", footer_keys
+
+        # The alarm list: the first alarm acknowledged with a cause, what it was, the action.
+        first = app.runner.state().alarm_list[0]
+        await pilot.press("a")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, AlarmsScreen))
+        await pilot.press("a")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, AckDialog))
+        await pilot.press("down", "down", "enter")  # temperature
+        await pilot.press(*"cell door open", "enter")
+        await pilot.press(*"waited for warm-up", "enter")
+        await tui.wait_until(pilot, lambda: app.runner.state().alarm_list[0].acknowledged)
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, AlarmsScreen))
+        assert app.runner.state().alarm_list[0].seq == first.seq
+        await pilot.pause(0.3)
+        listed = "\n".join(str(i.children[0].render()) for i in app.screen.query("AlarmItem"))
+        assert listed.count("acknowledged: temperature (cell door open)") == 1, listed
+        await pilot.press("escape")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, DashboardScreen))
+        await pilot.pause(0.3)
+        alarms = str(app.screen.query_one(AlarmLog).render())
+        assert "acknowledged: temperature" in alarms, alarms
 
         await pilot.press("f")
         await tui.wait_until(pilot, lambda: isinstance(app.screen, SummaryScreen))
@@ -105,6 +134,12 @@ async def test_full_repeatability_session(tmp_path: Path, fixture_pty, tui) -> N
         assert "NOT CAPABLE" in verdict and "CAPABLE" in verdict
         shown = summary.view
         assert shown.excluded_cycles == (5,)
+        listed = " ".join(_text(app, "#summary-alarms").split())
+        assert (
+            f"#{first.seq} {first.channel}, {first.rule_name} [live]" in listed
+            and "acknowledged: temperature (cell door open); corrective action: waited for warm-up"
+            in listed
+        ), listed
 
         # Exports beside the session file.
         await pilot.press("e")
@@ -114,7 +149,10 @@ async def test_full_repeatability_session(tmp_path: Path, fixture_pty, tui) -> N
     files = list(tmp_path.glob("*.jsonl"))
     assert len(files) == 1
     session_file = files[0]
-    assert session_file.with_name(session_file.stem + ".report.txt").is_file()
+    report = session_file.with_name(session_file.stem + ".report.txt").read_text()
+    assert "acknowledged: temperature (cell door open); corrective action: waited for" in (
+        " ".join(report.split())
+    )
     csv_text = session_file.with_name(session_file.stem + ".csv").read_text()
     assert f"rejected: {REASON}" in csv_text
 

@@ -154,3 +154,25 @@ def test_figures() -> None:
     assert overall_verdict(["CAPABLE", "NOT CAPABLE"]) == "NOT CAPABLE"
     assert overall_verdict(["CAPABLE", "CAPABLE"]) == "CAPABLE"
     assert overall_verdict(["CAPABLE", "UNDEFINED"]) == "UNDEFINED"
+
+
+def test_stats_table_flags_out_of_spec_and_says_provisional() -> None:
+    analysis = _analysis(n=9)
+    rows = StatsRows(
+        channels=("x", "y", "z"),
+        analyses=analysis.channels,
+        last={"x": 0.0001, "y": 0.0011, "z": -0.00105},
+        decimals=decimals_for(RESOLUTION),
+        flags={"y": "above", "z": "below"},
+    )
+    console = Console(width=76, record=True, color_system=None)
+    console.print(stats_table(rows))
+    text = console.export_text()
+    assert all(cell_len(line) <= 76 for line in text.splitlines())
+    assert "…" not in text, text  # no figure cut to fit
+    assert "+0.00110▲" in text and "-0.00105▼" in text and "+0.00010▲" not in text
+    assert "PROVISIONAL: 9 of 25 readings, 16 more before a verdict" in text
+    assert "CAPABLE" not in text  # nothing judged from 9 readings
+    # The out column counts each channel's readings beyond a limit.
+    y_row = next(line for line in text.splitlines() if line.lstrip().startswith("y"))
+    assert y_row.split()[-2] == str(analysis.channels["y"].out_of_spec.total)

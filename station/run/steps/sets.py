@@ -63,9 +63,6 @@ class SetStep(StepHandler):
     def after_cycle(self, run: Runner, item: PlanItem, by: str) -> None:
         """What a recorded cycle does to the step (complete it, or say the target is met)."""
 
-    def closing(self, run: Runner, item: PlanItem) -> None:
-        run.record_snapshot_alarms()
-
 
 class CaptureStep(SetStep):
     """One reading set, then the step is done."""

@@ -5,7 +5,9 @@ The screen holds no session: it shows the :class:`~station.session.alarms.Record
 it is given and hands each acknowledgement to the ``on_acknowledge`` callback as an
 :class:`~station.session.alarms.AckRequest` (the engine writes the ``ack`` event). A callback
 that refuses (a StationError) leaves the alarm unacknowledged and its sentence is shown.
-:meth:`AlarmsScreen.set_alarms` replaces the list (new alarms, acks from the journal).
+:meth:`AlarmsScreen.set_alarms` replaces the list (new alarms, acks from the journal); on the
+live dashboard the app hands the screen each new runner state (:meth:`AlarmsScreen.show_state`),
+and ``in_thread`` runs the callback (the engine's fsynced write) off the UI thread.
 
 Keys: ↑ ↓ choose, ``a`` acknowledge, Escape back. In the dialog: ↑ ↓ and Enter pick the cause,
 then type what it was (needed for "other") and the corrective action; Enter on the action saves.
@@ -17,6 +19,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 
 from rich.text import Text
+from textual import work
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Vertical
@@ -34,7 +37,7 @@ from station.session.alarms import (
 )
 
 
-def alarm_text(alarm: RecordedAlarm) -> Text:
+def alarm_text(alarm: RecordedAlarm, *, hint: bool = True) -> Text:
     """The full text of one alarm (no markup: every part is plain text): where, the rule in
     words, live or retrospective, the sentence, and its acknowledgement."""
     where = "live" if alarm.live else "retrospective"
@@ -46,15 +49,15 @@ def alarm_text(alarm: RecordedAlarm) -> Text:
     if alarm.acks:
         text.append(f"\nacknowledged: {plain(alarm.acks[-1].describe())}", style="green")
     else:
-        text.append("\nnot acknowledged: press a", style="yellow")
+        text.append("\nnot acknowledged" + (": press a" if hint else ""), style="yellow")
     return text
 
 
 class AlarmItem(ListItem):
     """One alarm of the list."""
 
-    def __init__(self, alarm: RecordedAlarm) -> None:
-        super().__init__(Static(alarm_text(alarm), classes="alarm-text"))
+    def __init__(self, alarm: RecordedAlarm, *, hint: bool = True) -> None:
+        super().__init__(Static(alarm_text(alarm, hint=hint), classes="alarm-text"))
         self.alarm = alarm
 
 
@@ -153,16 +156,31 @@ class AlarmsScreen(Screen[None]):
         alarms: Sequence[RecordedAlarm],
         causes: Sequence[str] = DEFAULT_CAUSES,
         on_acknowledge: Callable[[AckRequest], None] | None = None,
+        *,
+        read_only: bool = False,
+        in_thread: bool = False,
     ) -> None:
         super().__init__()
         self.alarms: list[RecordedAlarm] = list(alarms)
         self.causes = tuple(causes)
         self.on_acknowledge = on_acknowledge
+        self.read_only = read_only
+        """A recorded session: the alarms are shown, nothing is acknowledged."""
+        self.in_thread = in_thread
+        self._sent: tuple[RecordedAlarm, ...] | None = None
+
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """No acknowledging in a recorded session."""
+        if action == "acknowledge":
+            return not self.read_only
+        return True
 
     def compose(self) -> ComposeResult:
         """Title, the list, the keys."""
         yield Static(self._title(), id="alarm-title")
-        yield ListView(*[AlarmItem(alarm) for alarm in self.alarms], id="alarm-list")
+        yield ListView(
+            *[AlarmItem(alarm, hint=not self.read_only) for alarm in self.alarms], id="alarm-list"
+        )
         yield Footer()
 
     def _title(self) -> Text:
@@ -178,13 +196,21 @@ class AlarmsScreen(Screen[None]):
         """Focus the list."""
         self.query_one(ListView).focus()
 
+    def show_state(self, state: object) -> None:
+        """A new runner state: show its alarms when they changed (new ones, acknowledgements)."""
+        alarms = tuple(getattr(state, "alarm_list", ()) or ())
+        if alarms != self._sent:
+            self._sent = alarms
+            if list(alarms) != self.alarms:
+                self.set_alarms(alarms)
+
     def set_alarms(self, alarms: Sequence[RecordedAlarm]) -> None:
         """Show this list instead (new alarms, acknowledgements read back from the journal)."""
         self.alarms = list(alarms)
         view = self.query_one(ListView)
         index = view.index
         view.clear()
-        view.extend(AlarmItem(alarm) for alarm in self.alarms)
+        view.extend(AlarmItem(alarm, hint=not self.read_only) for alarm in self.alarms)
         if self.alarms:
             view.index = min(index or 0, len(self.alarms) - 1)
         self.query_one("#alarm-title", Static).update(self._title())
@@ -206,12 +232,39 @@ class AlarmsScreen(Screen[None]):
     def _acknowledged(self, request: AckRequest | None) -> None:
         if request is None:
             return
+        if self.on_acknowledge is not None and self.in_thread:
+            self._send(request)
+            return
         if self.on_acknowledge is not None:
             try:
                 self.on_acknowledge(request)
             except StationError as problem:
                 self.notify(problem.message, severity="error")
                 return
+        self._show_acknowledged(request)
+
+    @work(thread=True, group="acknowledge", exit_on_error=False)
+    def _send(self, request: AckRequest) -> None:
+        """Thread worker: the callback writes (and fsyncs) the ``ack`` event."""
+        assert self.on_acknowledge is not None
+        try:
+            self.on_acknowledge(request)
+        except StationError as problem:
+            self.app.call_from_thread(
+                self.notify, plain(problem.message), severity="error", markup=False
+            )
+            return
+        self.app.call_from_thread(self._show_acknowledged, request)
+
+    def _show_acknowledged(self, request: AckRequest) -> None:
+        if not self.is_mounted:
+            return
+        for alarm in self.alarms:
+            if alarm.seq == request.alarm and any(
+                (ack.cause, ack.text, ack.action) == (request.cause, request.text, request.action)
+                for ack in alarm.acks
+            ):
+                return  # the runner's new state already shows it
         ack = Acknowledgement(
             seq=0,
             alarm=request.alarm,

@@ -25,7 +25,7 @@ from station.errors import StationError
 from station.tui.messages import CaptureFinished
 from station.tui.remedies import explained
 from station.tui.text import shown, shown_line
-from station.tui.widgets.alarm_log import AlarmLog, alarm_lines
+from station.tui.widgets.alarm_log import AlarmLog, alarm_lines, recorded_alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.figures import decimals_for
 from station.tui.widgets.histogram import HistogramView, histogram_data
@@ -55,6 +55,13 @@ class DashboardView:
     resolution: float | None = None
     unit: str = ""
     ready_to_finish: bool = False
+    flags: Mapping[str, str] = field(default_factory=dict)
+    """Channel -> "above"/"below" when its last reading is beyond a specification limit."""
+    alarms: tuple[Any, ...] | None = None
+    """The alarms the session recorded (``RecordedAlarm``, with their acknowledgements); None:
+    the log shows the chart's alarms instead (a file without alarm events)."""
+    no_alarms: str = "alarms: none"
+    """What the log says while there is no alarm (live: when the control limits freeze)."""
 
     @classmethod
     def from_live(
@@ -108,6 +115,9 @@ class DashboardView:
             resolution=header.get("resolution"),
             unit=str(header.get("unit", "")),
             ready_to_finish=ready,
+            flags=out_of_spec_flags(last_cycle.values if last_cycle is not None else {}, header),
+            alarms=tuple(state.alarm_list),
+            no_alarms=no_alarms_words(header, len(accepted)),
         )
 
 
@@ -123,6 +133,7 @@ class DashboardScreen(Screen[None]):
         Binding("n", "note", "Note"),
         Binding("p", "pause", "Pause"),
         Binding("f", "finish", "Finish"),
+        Binding("a", "alarms", "Alarms"),
         Binding("tab", "next_axis", "Axis", key_display="xyz"),
         Binding("x", "axis('x')", "x", show=False),
         Binding("y", "axis('y')", "y", show=False),
@@ -221,6 +232,7 @@ class DashboardScreen(Screen[None]):
                 decimals=decimals_for(view.resolution),
                 unit=view.unit,
                 selected=self.selected,
+                flags=view.flags,
             )
         )
 
@@ -233,7 +245,16 @@ class DashboardScreen(Screen[None]):
         self.query_one(ControlChartView).show(
             chart_data(selected, list(view.cycle_numbers), decimals)
         )
-        self.query_one(AlarmLog).show(alarm_lines(view.analyses, view.cycle_numbers))
+        log = self.query_one(AlarmLog)
+        if view.alarms is not None:
+            log.show(
+                recorded_alarm_lines(view.alarms),
+                open_count=sum(not alarm.acknowledged for alarm in view.alarms),
+                more="a: the full list",
+                empty=view.no_alarms,
+            )
+        else:
+            log.show(alarm_lines(view.analyses, view.cycle_numbers))
         instruments = self.query_one(InstrumentStatus)
         if self.live:
             instruments.show(view.ports)
@@ -247,6 +268,13 @@ class DashboardScreen(Screen[None]):
                 style = {"error": "bold red", "warning": "yellow"}.get(view.message.level, "green")
                 self._say(view.message.text, style)
         self._drawn_once = True
+
+    def on_screen_resume(self) -> None:
+        """Back from the alarm list or a dialog: draw the newest state."""
+        if self.live and self.is_mounted:
+            state = self.app.current_state()
+            if state is not None:
+                self.show_state(state)
 
     def _say(self, text: str, style: str = "") -> None:
         self.query_one("#dash-message", Static).update(shown(text, style=style))
@@ -409,6 +437,26 @@ class DashboardScreen(Screen[None]):
         except StationError as error:
             self._say(explained(error), "bold red")
 
+    def action_alarms(self) -> None:
+        """The alarm list: every alarm in full, acknowledged with a cause (live) or read."""
+        from station.tui.screens.alarms import AlarmsScreen
+
+        view = self.view
+        alarms = tuple(view.alarms or ()) if view is not None else ()
+        runner = self.app.runner if self.live else None
+        if runner is None:
+            self.app.push_screen(AlarmsScreen(alarms, read_only=True))
+            return
+
+        def acknowledge(request: Any) -> None:
+            runner.acknowledge(
+                request.alarm, request.cause, text=request.text, action=request.action
+            )
+
+        self.app.push_screen(
+            AlarmsScreen(alarms, runner.setup.procedure.causes, acknowledge, in_thread=True)
+        )
+
     def action_help(self) -> None:
         """The keys."""
         from station.tui.screens.dialogs import HelpScreen
@@ -441,6 +489,37 @@ class DashboardScreen(Screen[None]):
         )
 
 
+def out_of_spec_flags(last: Mapping[str, float], header: Mapping[str, Any]) -> dict[str, str]:
+    """Channel -> "above" / "below" for each last reading beyond the session's specification
+    limits (flagged the moment the reading is on disk, before the analysis catches up)."""
+    from station.session.header import header_limits
+
+    flags: dict[str, str] = {}
+    for channel, limits in header_limits(header).items():
+        value = last.get(channel)
+        if value is None:
+            continue
+        if limits.usl is not None and value > limits.usl:
+            flags[channel] = "above"
+        elif limits.lsl is not None and value < limits.lsl:
+            flags[channel] = "below"
+    return flags
+
+
+def no_alarms_words(header: Mapping[str, Any], accepted: int) -> str:
+    """The alarm log's words while there is no alarm: live alarms are judged against control
+    limits that freeze after the header's ``freeze_after`` cycles (or a baseline's), so before
+    that none can come, and the operator is told when they will."""
+    if header.get("baseline"):
+        return "alarms: none (judged against the baseline's control limits)"
+    freeze = header.get("freeze_after")
+    if isinstance(freeze, int) and accepted < freeze:
+        return (
+            f"alarms: none yet: live limits freeze after {freeze} cycles, earlier ones judged then"
+        )
+    return "alarms: none"
+
+
 def session_title(header: Mapping[str, Any]) -> str:
     """``robot R1 · repeatability`` from a session header's fields."""
     procedure = header.get("procedure")
@@ -457,8 +536,9 @@ def review_view(
     resolution: float | None,
     unit: str,
     progress: str,
+    alarms: Sequence[Any] | None = None,
 ) -> DashboardView:
-    """The dashboard of a saved session (read-only)."""
+    """The dashboard of a saved session (read-only); ``alarms``: its recorded alarms."""
     return DashboardView(
         title=title,
         progress=progress,
@@ -468,4 +548,5 @@ def review_view(
         cycle_numbers=tuple(cycle_numbers),
         resolution=resolution,
         unit=unit,
+        alarms=tuple(alarms) if alarms else None,
     )

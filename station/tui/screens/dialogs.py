@@ -92,7 +92,11 @@ HELP_TEXT = """\
 [b]Capture[/b]  Space capture a cycle · r reject the last cycle (asks why; nothing is deleted)
   n note · p pause / continue · f finish · x y z or Tab choose the axis in the charts
   g go on to the next step (once the step has its minimum cycles, e.g. the next joint)
+  a alarms: the full list, scrollable; a on an alarm acknowledges it with a cause from the
+  procedure's list, what it was and the corrective action (written to the session file)
   q leave (the session stays resumable)
+  A reading beyond a specification limit is marked ▲ (above the USL) or ▼ (below the LSL) at
+  once; the column "out" counts each axis' readings out of specification.
 
 [b]Strokes[/b]  (linearity) the strokes stream as the robot shuttles A↔B · e end the stroke
   now (streaming stops; Space streams again) · f finish · h v or Tab choose the indicator
@@ -102,7 +106,14 @@ HELP_TEXT = """\
 Every reading is on disk (fsynced) before it is shown as captured. If the link drops, the
 session is marked interrupted; run `station` again and choose Resume.
 Verdicts: CAPABLE when Cpk ≥ the threshold (1.00 by default), NOT CAPABLE otherwise,
-UNDEFINED when there are no limits or too few readings.
+UNDEFINED when there are no limits or too few readings. PROVISIONAL: 9 of 25 while fewer
+readings than the procedure's minimum are in (the Cpk shown is where the figures point so far).
+The Cpk is shown with as many decimals as it takes to sit on the same side of the threshold.
+Alarms: report rule 1 = a point beyond the control limits; report rule 2 = seven points in a
+row going up or down; report rule 3 = fifteen points in a row alternating up and down; report
+rule 4 = two of three points beyond 2 sigma on one side; drift rule = the EWMA of the mean
+beyond its limits. Live alarms are judged against control limits frozen after the first
+cycles (phase II), so an alarm once raised never goes away.
 """
 
 

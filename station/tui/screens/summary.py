@@ -1,5 +1,8 @@
-"""The summary: the verdict per axis and overall, the 3-D figures, the hints, the file and its
-hash, and the exports (the text report and CSV) into the sessions folder.
+"""The summary: the verdict per axis and overall (PROVISIONAL below the minimum count, the Cpk
+with the digits that agree with the word), readings out of specification, the 3-D figures, the
+alarms (recorded live with their acknowledgements, and the retrospective chart's, each marked),
+the hints (drift, autocorrelation, non-normal data among them), the file and its hash, and the
+exports (the text report and CSV) into the sessions folder.
 
 It shows the analysis the runner returned on finish, or, when reviewing, the analysis of a saved
 session; the words and figures come from the analysis and the report module, unchanged.
@@ -22,7 +25,12 @@ from textual.screen import Screen
 from textual.widgets import Footer, Static
 
 from station.errors import StationError
-from station.text import overall_verdict, verdict_word
+from station.text import (
+    judged_cpk,
+    judged_label,
+    judged_word,
+    overall_judgement,
+)
 from station.tui.remedies import explained
 from station.tui.text import shown, shown_line
 from station.tui.widgets.figures import (
@@ -132,7 +140,8 @@ def report_text(view: SummaryView) -> Text:
 
 
 def verdict_text(view: SummaryView) -> Text:
-    """The verdict block: overall, then one line per axis with Cp, Cpk and the reason."""
+    """The verdict block: overall, then one line per axis with Cp, Cpk and the reason, and the
+    readings out of specification."""
     analysis = view.analysis
     text = Text()
     if analysis is None and view.report is not None and not view.report.empty:
@@ -140,25 +149,80 @@ def verdict_text(view: SummaryView) -> Text:
         return Text("No capability verdict: this procedure judges no readings (its report below).")
     if analysis is None:
         return Text("No accepted cycles: there is nothing to judge yet.", style="bold yellow")
-    words = [verdict_word(c.capability) for c in analysis.channels.values()]
-    overall = overall_verdict(words)
+    overall = overall_judgement(analysis.channels.values())
     text.append("Verdict: ", style="bold")
-    text.append(overall, style=VERDICT_STYLES[overall])
+    text.append(overall, style=VERDICT_STYLES.get(overall.partition(":")[0], ""))
     threshold = analysis.config.threshold
-    text.append(f"   (capable when Cpk ≥ {threshold:.2f}; unit: {view.unit})\n", style="dim")
+    text.append(
+        f"   (Cpk ≥ {threshold:g} is capable; final from {analysis.config.min_n} readings; "
+        f"unit {view.unit})\n",
+        style="dim",
+    )
     for name, channel in analysis.channels.items():
-        word = verdict_word(channel.capability)
+        word = judged_word(channel)
         capability = channel.capability
         descriptive = channel.descriptive
         text.append(f"  {shown_line(name, limit=20)}  ", style="bold")
-        text.append(f"{word:<11}", style=VERDICT_STYLES[word])
+        text.append(f"{judged_label(channel):<11}", style=VERDICT_STYLES.get(word, ""))
         text.append(
-            f" Cp {ratio(capability.cp)}  Cpk {ratio(capability.cpk)} (95%: ≥"
+            f" Cp {ratio(capability.cp)}  Cpk {judged_cpk(channel)} (95%: ≥"
             f"{ratio(capability.cpk_lower)})  X̄ {number(descriptive.mean, view.decimals)}"
             f"  σ {number(descriptive.sd, view.decimals, signed=False)}\n"
         )
         if word == "UNDEFINED" and capability.message:
             text.append(f"      {shown_line(capability.message, limit=None)}\n", style="yellow")
+        found = channel.out_of_spec
+        if found is not None and found.total:
+            cycles = ", ".join(str(c) for c in found.cycles)
+            text.append(
+                f"      out of specification: {found.total} reading"
+                f"{'s' if found.total > 1 else ''} ({found.below} below the LSL, {found.above} "
+                f"above the USL), cycle{'s' if found.total > 1 else ''} {cycles}\n",
+                style="bold red",
+            )
+    return text
+
+
+def alarms_text(view: SummaryView) -> Text:
+    """The alarms: those recorded while capturing (live, against the frozen limits) with their
+    acknowledgements, and those of the retrospective chart (limits from every reading), each
+    rule named in words and marked live or retrospective."""
+    from station.analysis.rules import rule_name
+
+    text = Text("Alarms\n", style="bold")
+    recorded = tuple(getattr(view.report, "recorded_alarms", None) or ())
+    if recorded:
+        text.append(f"  recorded while capturing ({len(recorded)}):\n")
+        for alarm in recorded:
+            where = "live" if alarm.live else "retrospective"
+            text.append(
+                f"  #{alarm.seq} {shown_line(alarm.channel, limit=20)}, "
+                f"{shown_line(alarm.rule_name, limit=None)} [{where}]: "
+                f"{shown_line(alarm.text, limit=None)}\n"
+            )
+            if alarm.acks:
+                text.append(
+                    f"      acknowledged: {shown_line(alarm.acks[-1].describe(), limit=None)}\n",
+                    style="green",
+                )
+            else:
+                text.append("      not acknowledged\n", style="yellow")
+    else:
+        text.append("  none recorded while capturing\n", style="dim")
+    channels = getattr(view.analysis, "channels", {}) or {}
+    retrospective = [
+        (name, alarm, channel.alarm_is_live(alarm))
+        for name, channel in channels.items()
+        for alarm in getattr(channel, "alarms", ()) or ()
+    ]
+    if retrospective:
+        text.append(f"  retrospective chart (limits from every reading, {len(retrospective)}):\n")
+        for name, alarm, live in retrospective:
+            mark = "live and retrospective" if live else "retrospective only"
+            text.append(
+                f"  {shown_line(name, limit=20)}, {rule_name(alarm.rule)} [{mark}]: "
+                f"{shown_line(alarm.text, limit=None)}\n"
+            )
     return text
 
 
@@ -258,6 +322,7 @@ class SummaryScreen(Screen[None]):
         with VerticalScroll(id="summary-body"):
             yield Static(_trimmed(verdict_text(self.view)), id="summary-verdict")
             yield Static(_trimmed(spatial_text(self.view)), id="summary-spatial")
+            yield Static(_trimmed(alarms_text(self.view)), id="summary-alarms")
             report = Static(report_text(self.view), id="summary-report")
             report.display = self.view.report is not None and bool(self.view.report.sections)
             yield report
@@ -343,6 +408,7 @@ class SummaryScreen(Screen[None]):
                     resolution=float(resolution) if resolution else None,
                     unit=str(header.get("unit", "")),
                     progress=f"{cycles} accepted cycles, {self.view.status}",
+                    alarms=getattr(self.view.report, "recorded_alarms", None),
                 ),
             )
         )

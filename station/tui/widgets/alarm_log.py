@@ -1,4 +1,7 @@
-"""The alarm log: each control-chart alarm with its channel, cycle and rule, newest last."""
+"""The alarm log: each alarm with its channel, cycle and rule (in words), newest last.
+
+On the live dashboard it shows the alarms the session recorded (phase II: they never go away)
+with their acknowledgement; the full texts are on the alarm list (key ``a``)."""
 
 from __future__ import annotations
 
@@ -36,6 +39,27 @@ def alarm_lines(
     return [line for _, line in lines]
 
 
+def recorded_alarm_lines(alarms: Sequence[Any]) -> list[str]:
+    """One line per recorded alarm (:class:`~station.session.alarms.RecordedAlarm`), oldest
+    first: ``#41 y cycle 27, report rule 1 (a point beyond the control limits): <sentence>
+    [not acknowledged]``."""
+    lines = []
+    for alarm in alarms:
+        cycles = list(alarm.cycles)
+        where = (
+            f"cycle {cycles[-1]}"
+            if len(cycles) == 1
+            else f"cycles {cycles[0]}-{cycles[-1]}"
+            if cycles
+            else "cycle ?"
+        )
+        status = f"acknowledged: {alarm.acks[-1].cause}" if alarm.acks else "not acknowledged"
+        lines.append(
+            f"#{alarm.seq} {alarm.channel} {where}, {alarm.rule_name} [{status}]: {alarm.text}"
+        )
+    return lines
+
+
 class AlarmLog(Static):
     """The latest alarms; says so plainly when there is none."""
 
@@ -48,20 +72,32 @@ class AlarmLog(Static):
         self._lines: list[str] | None = None
         self.max_shown = 3
 
-    def show(self, lines: list[str]) -> None:
-        """Show the newest alarms (UI thread only)."""
-        if lines == self._lines:
+    def show(
+        self,
+        lines: list[str],
+        *,
+        open_count: int | None = None,
+        more: str = "",
+        empty: str = "alarms: none",
+    ) -> None:
+        """Show the newest alarms (UI thread only); ``open_count``: how many are not
+        acknowledged yet; ``more``: where the full list is (``a: the full list``); ``empty``:
+        what to say while there is none."""
+        extra = (open_count, more, empty)
+        if lines == self._lines and extra == getattr(self, "_extra", None):
             return
         self._lines = list(lines)
+        self._extra = extra
         if not lines:
-            self.update(Text("alarms: none", style="dim"))
+            self.update(Text(empty, style="dim"))
             return
         shown = lines[-self.max_shown :]
-        head = (
-            f"alarms ({len(lines)}):"
-            if len(lines) <= self.max_shown
-            else (f"alarms ({len(lines)}, newest {len(shown)}):")
-        )
+        counts = f"{len(lines)}"
+        if open_count is not None:
+            counts += f", {open_count} not acknowledged"
+        if len(lines) > self.max_shown:
+            counts += f", newest {len(shown)}"
+        head = f"alarms ({counts})" + (f" · {more}:" if more else ":")
         text = Text(head, style="bold red", no_wrap=True, overflow="ellipsis")
         for line in shown:
             text.append("\n⚠ " + shown_line(line), style="red")

@@ -13,6 +13,7 @@ VERDICT_STYLES = {
     "CAPABLE": "bold green",
     "NOT CAPABLE": "bold red",
     "UNDEFINED": "bold yellow",
+    "PROVISIONAL": "bold yellow",
 }
 
 

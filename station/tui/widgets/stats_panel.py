@@ -1,8 +1,12 @@
-"""The per-axis statistics table: live reading, n, X̄, σ, a₁, range, Cp, Cpk and the verdict word.
+"""The per-axis statistics table: live reading, n, X̄, σ, a₁, range, Cp, Cpk, the readings out
+of specification and the verdict word.
 
 One row per channel, so x, y and z sit one above the other and the table fits 80 columns. The
-selected channel (the one the charts below show) is marked with ``▶``. Values come from the
-analysis the runner keeps; nothing is computed here.
+selected channel (the one the charts below show) is marked with ``▶``. A last reading beyond a
+specification limit is marked ``▲`` (above the USL) or ``▼`` (below the LSL) at once, and the
+``out`` column counts each channel's readings out of specification. Below the minimum count
+the verdict is PROVISIONAL, and a caption says how many readings are in of how many needed.
+Values come from the analysis the runner keeps; nothing is computed here.
 """
 
 from __future__ import annotations
@@ -16,9 +20,12 @@ from rich.table import Table
 from rich.text import Text
 from textual.widgets import Static
 
-from station.text import verdict_word
+from station.text import judged_cpk, judged_word
 from station.tui.text import shown_line
 from station.tui.widgets.figures import VERDICT_STYLES, number, ratio
+
+OUT_OF_SPEC_MARKS = {"above": "▲", "below": "▼"}
+"""How the reading column marks a reading beyond the USL or the LSL (a mark, not a colour)."""
 
 
 @dataclass(frozen=True)
@@ -32,35 +39,57 @@ class StatsRows:
     decimals: int = 5
     unit: str = ""
     selected: str = ""
+    flags: Mapping[str, str] = field(default_factory=dict)
+    """Channel -> "above" or "below" when its last reading is beyond a specification limit."""
 
 
 def stats_table(rows: StatsRows) -> Table:
     """A compact rich table, at most 78 cells wide for three channels."""
-    table = Table(
-        box=box.SIMPLE_HEAD, padding=(0, 1), collapse_padding=True, pad_edge=False, expand=True
-    )
+    # No padding: the box's column dividers are the one-space gaps, so eleven columns (the
+    # reading's out-of-spec mark, the out count, a PROVISIONAL or NOT CAPABLE word, a Cpk with
+    # four decimals) fit 76 cells without cutting a figure.
+    table = Table(box=box.SIMPLE_HEAD, padding=(0, 0), pad_edge=False, show_edge=False, expand=True)
     table.add_column("", width=3, no_wrap=True)
-    for heading in ("reading", "n", "X̄", "σ", "a₁", "range", "Cp", "Cpk"):
+    for heading in ("reading", "n", "X̄", "σ", "a₁", "range", "Cp", "Cpk", "out"):
         table.add_column(heading, justify="right", no_wrap=True)
     table.add_column("verdict", no_wrap=True, min_width=11)
+    provisional = []
     for channel in rows.channels:
         analysis = rows.analyses.get(channel)
         descriptive = getattr(analysis, "descriptive", None)
         capability = getattr(analysis, "capability", None)
-        word = verdict_word(capability) if analysis is not None else "—"
+        word = judged_word(analysis) if analysis is not None else "—"
+        verdict = getattr(analysis, "verdict", None)
+        if verdict is not None and verdict.provisional:
+            provisional.append(verdict)
         marker = "▶" if channel == rows.selected else " "
+        flag = rows.flags.get(channel)
+        reading = Text(number(rows.last.get(channel), rows.decimals))
+        reading.append(OUT_OF_SPEC_MARKS.get(flag or "", " "), style="bold red")
+        if flag:
+            reading.stylize("bold red")
+        found = getattr(analysis, "out_of_spec", None)
+        out = getattr(found, "total", 0) if found is not None else 0
         table.add_row(
             Text(f"{marker}{shown_line(channel, limit=20)}", style="bold"),
-            number(rows.last.get(channel), rows.decimals),
+            reading,
             str(getattr(descriptive, "n", 0)),
             number(getattr(descriptive, "mean", None), rows.decimals),
             number(getattr(descriptive, "sd", None), rows.decimals, signed=False),
             ratio(getattr(descriptive, "skewness", None)),
             number(getattr(descriptive, "range", None), rows.decimals, signed=False),
             ratio(getattr(capability, "cp", None)),
-            ratio(getattr(capability, "cpk", None)),
+            judged_cpk(analysis) if analysis is not None else ratio(None),
+            Text(str(out), style="bold red" if out else "dim"),
             Text(word, style=VERDICT_STYLES.get(word, "")),
         )
+    if provisional:
+        fewest = min(provisional, key=lambda verdict: verdict.n)
+        table.caption = (
+            f"PROVISIONAL: {fewest.n} of {fewest.min_n} readings, "
+            f"{fewest.min_n - fewest.n} more before a verdict"
+        )
+        table.caption_justify = "left"
     return table
 
 
