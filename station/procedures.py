@@ -23,6 +23,10 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
     min = 25
     target = 30
 
+    trigger = "arrival"             # optional: the trigger a session takes by default where
+                                    # the gauges can be read continuously (a polled protocol):
+                                    # poll, push, stable or arrival; else poll
+
     [arrival]                       # optional: the arrival trigger (cycles paced by the robot)
     band = 0.01                     # a channel farther than this from its zero has left the
                                     # fixture (in `unit`; default 100 x the gauge resolution)
@@ -277,6 +281,9 @@ class Procedure:
     """How its sessions are analysed: the file's ``analysis``, else by its steps."""
     arrival: ArrivalConfig = field(default_factory=ArrivalConfig)
     """The ``arrival`` trigger's parameters: the file's ``[arrival]``, else the defaults."""
+    trigger: str | None = None
+    """The trigger its sessions take by default where the gauges can be read continuously (the
+    file's ``trigger``); None: poll."""
     causes: tuple[str, ...] = DEFAULT_CAUSES
     """The assignable causes an alarm is acknowledged with; "other" (with a text) is last."""
 
@@ -456,6 +463,7 @@ _TOP_KEYS = (
     "causes",
     "steps",
     "arrival",
+    "trigger",
 )
 _COMMON_STEP_KEYS = ("id", "kind", "title", "text")
 _FIELD_KEYS = ("name", "label", "type", "unit", "required")
@@ -561,6 +569,12 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
 
     limits = _parse_limits(check, check.get(table, "limits", dict, "", required=False), channels)
     arrival = _parse_arrival(check, check.get(table, "arrival", dict, "", required=False))
+    trigger = check.get(table, "trigger", str, "", required=False)
+    if trigger is not None:
+        from station.instruments.gauge import TRIGGERS
+
+        if trigger not in TRIGGERS:
+            raise check.fail("", f"'trigger' must be one of {', '.join(TRIGGERS)}, not {trigger!r}")
 
     raw_steps = check.get(table, "steps", list, "")
     if not raw_steps:
@@ -588,6 +602,7 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
         sha256=hashlib.sha256(data).hexdigest(),
         analysis=analysis,
         arrival=arrival,
+        trigger=trigger,
         causes=causes,
     )
 

@@ -54,6 +54,7 @@ import getpass
 import signal
 import sys
 import threading
+import time
 from pathlib import Path
 from typing import Any
 
@@ -119,9 +120,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--trigger",
-        choices=("poll", "push", "stable"),
-        help="poll: ask the gauges; push: they send (DATA button, foot switch); stable: take "
-        "the set once it settles (default poll)",
+        choices=("poll", "push", "stable", "arrival"),
+        help="poll: ask the gauges (paced by --every or Enter); push: they send (DATA button, "
+        "foot switch); stable: take the set once it settles; arrival: read continuously and "
+        "take a set each time the robot leaves and comes back to rest (default: the "
+        "procedure's trigger for a polled protocol, else poll)",
+    )
+    parser.add_argument(
+        "--every",
+        metavar="S",
+        help="poll: at least S seconds between two cycles (without it, and without a "
+        "terminal to press Enter in, poll is refused)",
     )
     parser.add_argument(
         "--map", metavar="1=x,2=y,3=z", help="device to station channels (default 1, 2, 3 ...)"
@@ -293,7 +302,7 @@ def _setup(args: argparse.Namespace) -> Any:
         robot=args.robot,
         operator=args.operator if args.operator is not None else getpass.getuser(),
         ports=(PortSetup(args.port, args.protocol, _channel_map(args, procedure.channels)),),
-        trigger=args.trigger or "poll",
+        trigger=args.trigger or default_trigger(procedure, args.protocol),
         unit=args.unit,
         resolution=resolution,
         limits=limits or None,
@@ -301,6 +310,17 @@ def _setup(args: argparse.Namespace) -> Any:
         placements=_positive(args.placements, "--placements", int) if args.placements else None,
         strokes=_positive(args.strokes, "--strokes", int) if args.strokes else None,
     )
+
+
+def default_trigger(procedure: Any, protocol: str) -> str:
+    """The trigger of a session without ``--trigger``: the procedure's own (the repeatability
+    procedure declares ``arrival``) where the gauges can be read continuously (a polled
+    protocol), else ``poll``."""
+    from station.instruments.protocols import get_protocol
+
+    if procedure.trigger and get_protocol(protocol).polled:
+        return str(procedure.trigger)
+    return "poll"
 
 
 def _channel_map(args: argparse.Namespace, channels: tuple[str, ...]) -> dict[str, str]:
@@ -372,6 +392,27 @@ def _resume_conflicts(args: argparse.Namespace, setup: Any) -> list[str]:
     return conflicts
 
 
+def _pacing(trigger: str, every_text: str | None) -> tuple[float | None, bool]:
+    """How a ``poll`` session paces its cycles: (``--every`` seconds, Enter at the terminal).
+    Without either, polling would record a cycle as fast as the gauges answer (a gauge standing
+    still, not a robot repeating): refused with the three ways to pace it."""
+    every = _positive(every_text, "--every") if every_text is not None else None
+    if every is not None and trigger in ("push", "arrival"):
+        who = "gauges" if trigger == "push" else "robot"
+        raise StationError(
+            f"--every paces --trigger poll; with --trigger {trigger} the {who} set the pace: "
+            "leave --every out"
+        )
+    if trigger != "poll" or every is not None:
+        return every, False
+    if sys.stdin is not None and sys.stdin.isatty():
+        return None, True
+    raise StationError(
+        "--trigger poll needs a pace: --every S (seconds between cycles), a terminal to press "
+        "Enter in for each cycle, or --trigger push or arrival (the gauges or the robot set it)"
+    )
+
+
 def _check_answerable(runner_plan: Any, procedure: Any, inputs: Inputs, done: set) -> None:
     """Refuse, before anything is written, a procedure this command cannot walk alone
     (``runner_plan``: the unrolled steps as (step, placement); ``done``: the (step id,
@@ -414,8 +455,13 @@ class _Headless:
         *,
         deadband: float | None = None,
         still: float = 2.0,
+        every: float | None = None,
+        enter: bool = False,
     ) -> None:
         self.runner = runner
+        self.every = every
+        self.enter = enter
+        self._last_capture = float("-inf")
         self.inputs = inputs
         self.timeout = timeout
         self.attempts = attempts
@@ -444,15 +490,34 @@ class _Headless:
         return sum(reader.reading_count for reader in getattr(self.runner.gauges, "readers", ()))
 
     def _idle(self, step: Any) -> None:
-        """Nobody pressed DATA during a wait: say once, until the next reading, that the
-        command waits for them (push: the operator sets the pace)."""
+        """Nobody pressed DATA (or the robot did not come back) during a wait: say once, until
+        the next set, that the command waits (the operator or the robot sets the pace)."""
         if not self._waiting:
+            what = "press DATA" if self.push else "run the robot's playback loop"
             print(
-                f"station: waiting for the gauges: press DATA (step {step.title!r})",
+                f"station: waiting for the gauges: {what} (step {step.title!r})",
                 file=sys.stderr,
                 flush=True,
             )
         self._waiting = True
+
+    def _pace(self, state: Any) -> bool:
+        """Poll: wait out ``--every`` since the last capture, or for Enter at the terminal
+        (after the prompt naming the cycle the file will record). False when the walk should
+        look at the state again first (the session changed meanwhile)."""
+        if self.every is not None:
+            delay = self._last_capture + self.every - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
+        elif self.enter:
+            print(f"{state.action.prompt}  [Enter]", file=sys.stderr, flush=True)
+            if not sys.stdin.readline():
+                raise StationError(
+                    "standard input closed while waiting for Enter: resume the session "
+                    "with --every S to pace its cycles without a terminal"
+                )
+        self._last_capture = time.monotonic()
+        return self.runner.state().status == "running"
 
     def _walk(self) -> None:
         """Do what the engine asks next until every step is done: one small call per action
@@ -474,9 +539,18 @@ class _Headless:
         self.runner.submit_input({f.name: given[f.name] for f in fields if f.name in given}, by=BY)
 
     def _zero(self, state: Any) -> None:
+        from station.instruments.zeroing import GaugesMoving
+
         seen = self._readings_seen()
         try:
             self.runner.zero(by=BY, timeout=self.timeout)
+        except GaugesMoving as moving:
+            # The robot is not at rest at the fixture yet: zero once it is (said once).
+            if not self._waiting:
+                print(f"station: waiting: {moving.message}", file=sys.stderr, flush=True)
+            self._waiting = True
+            time.sleep(0.1)
+            return
         except StationError:
             if self.push and self._readings_seen() == seen:
                 self._idle(state.current.step)  # nobody pressed DATA yet: the zero waits
@@ -501,12 +575,17 @@ class _Headless:
         if state.progress is not None and state.progress.complete:
             runner.confirm(by=BY)
             return
+        if not self._pace(state):
+            return
         seen = self._readings_seen()
         outcome = runner.capture(self.timeout, by=BY)
         if runner.state().status != "running":
             return
         if outcome.recorded:
             self._refused = 0
+        elif outcome.waited and not self.push:
+            self._idle(state.current.step)  # the robot has not come back yet: it sets the pace
+            return
         elif self.push and self._readings_seen() == seen:
             self._idle(state.current.step)  # no reading at all: nobody pressed DATA yet
             return
@@ -571,8 +650,9 @@ class _Printer:
         elif kind == "step":
             self._print(f"step {event['step']}: done (by {event.get('by', 'operator')})")
         elif kind == "zero":
-            zeroed = ", ".join(f"{ch} ({spec['method']})" for ch, spec in event["channels"].items())
-            self._print(f"zeroed {zeroed}")
+            from station.text import zero_text
+
+            self._print("zeroed " + zero_text(event["channels"], self.resolution))
         elif notice.message is not None and notice.message.level == "warning":
             # Errors are not printed here: each one also ends the command with its own line.
             text = notice.message.text
@@ -651,6 +731,7 @@ def run(args: argparse.Namespace) -> int:
     from station.run import plan_steps
 
     _check_answerable(plan_steps(setup), setup.procedure, inputs, done)
+    every, enter = _pacing(setup.trigger, args.every)
 
     caught: list[int] = []
     previous = {}
@@ -678,7 +759,16 @@ def run(args: argparse.Namespace) -> int:
             print(f"sessions folder: {folder} ({why})", flush=True)
             runner = Runner.start(setup, gauges, folder, listener=printer)
         print(f"session file: {runner.path}", flush=True)
-        headless = _Headless(runner, inputs, timeout, attempts, deadband=deadband, still=still)
+        headless = _Headless(
+            runner,
+            inputs,
+            timeout,
+            attempts,
+            deadband=deadband,
+            still=still,
+            every=every,
+            enter=enter,
+        )
         worker = threading.Thread(target=headless.run, name="station capture", daemon=True)
         worker.start()
         while not headless.done.wait(0.05):

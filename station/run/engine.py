@@ -37,6 +37,7 @@ from __future__ import annotations
 import contextlib
 import queue
 import threading
+import time
 from collections import deque
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
@@ -90,9 +91,21 @@ class Gauges(Protocol):
     readers: Sequence[Any]
 
     def capture(self, timeout: float = 2.0) -> CaptureResult: ...
-    def zero(self, channels: list[str], timeout: float, *, unit: str) -> Any: ...
+    def zero(
+        self,
+        channels: list[str],
+        timeout: float,
+        *,
+        unit: str,
+        readings: int = 1,
+        settle: float = 0.0,
+        still: float = 3.0,
+    ) -> Any: ...
     def set_zero_offsets(self, offsets: Mapping[str, float]) -> None: ...
-    def subscribe(self, *, on_set: Any = None, on_status: Any = None) -> Subscription: ...
+    def subscribe(
+        self, *, on_set: Any = None, on_status: Any = None, on_arrival: Any = None
+    ) -> Subscription: ...
+    def arm(self, timeout: float = 1.0) -> list[str]: ...
 
 
 class Journal(Protocol):
@@ -164,6 +177,8 @@ class Runner:
         self._alarm_count = 0
         self._alarm_flagged: dict[tuple[str, str], set[int]] = {}
         self._port_states: dict[str, str] = {}
+        self._arm_pending = False
+        self._armed_at = float("-inf")
         self.header: Mapping[str, Any] = writer.snapshot().header
         self.config = analysis_config(self.header)
         self.kind = verdicts.kind_of(setup.procedure.analysis)
@@ -311,12 +326,14 @@ class Runner:
             self._subscription = self.gauges.subscribe(
                 on_set=self._on_set if self.gauges.trigger in DEVICE_DRIVEN_TRIGGERS else None,
                 on_status=self._on_port_status,
+                on_arrival=self._on_arrival if self.gauges.trigger == "arrival" else None,
             )
             with self.lock:
                 # The file says how each line stood when the session (re)started; changes
                 # follow.
                 for url, state in self._port_states.items():
                     self.append("instrument", port=url, state=state, message=moment)
+                self._step_entered()
         except BaseException:
             with self.lock:
                 self._close()
@@ -341,6 +358,40 @@ class Runner:
             level: MessageLevel = "info" if status.state == "connected" else "warning"
             self.say(level, f"{status.port}: {status.state} ({status.message})")
 
+    def _on_arrival(self, event: Any) -> None:
+        """The arrival trigger's news (departed, returned, unsettled), on a reader's thread:
+        handed to the intake thread, which says it (reported, never recorded)."""
+        if self._intake is not None:
+            self._intake.put(("arrival", event))
+
+    def _say_arrival(self, event: Any) -> None:
+        """Say an arrival event: the robot's going and coming as information, a return that
+        did not settle as a warning (no set was taken for it). Lock held."""
+        if self.status not in ("running", "paused"):
+            return
+        if event.kind == "departed":
+            self.say("info", f"The robot left the fixture ({', '.join(event.channels)} away).")
+        elif event.kind == "returned":
+            self.say("info", "The robot returned to the fixture; waiting for it to be still.")
+        elif event.kind == "unsettled":
+            self.say("warning", event.message)
+
+    def arm_trigger(self) -> None:
+        """A step that takes sets became current: with the ``arrival`` trigger, only a
+        departure from now on starts a cycle (a robot already on its way back when the step
+        began is not one). The gauges are armed on the intake thread, without the lock; sets
+        that arrived before are not recorded. Lock held."""
+        if self.setup.trigger != "arrival" or self._intake is None:
+            return
+        self._arm_pending = True
+        self._intake.put(("arm",))
+
+    def _step_entered(self) -> None:
+        """Tell the current step's handler that it became current. Lock held."""
+        item = self._item_or_none()
+        if item is not None and self.status == "running":
+            handler_for(item.step.kind).entered(self, item)
+
     def _on_set(self, result: CaptureResult) -> None:
         """A completed set the devices sent (push, arrival), on the reader's thread: note which
         step was current and hand it over, without the engine's lock."""
@@ -362,6 +413,14 @@ class Runner:
             queued = intake.get()
             if queued is None:
                 return
+            if queued[0] == "arm":
+                # Waits on the reader threads (a flush): never under the engine's lock.
+                with contextlib.suppress(StationError):
+                    self.gauges.arm(1.0)
+                with self.lock:
+                    self._armed_at = time.monotonic()
+                    self._arm_pending = False
+                continue
             with self.lock:
                 if self._writer.closed:
                     continue  # closed while this waited: the file takes nothing more
@@ -369,6 +428,8 @@ class Runner:
                 with contextlib.suppress(StationError):
                     if queued[0] == "status":
                         self._record_port_status(queued[1])
+                    elif queued[0] == "arrival":
+                        self._say_arrival(queued[1])
                     else:
                         self._record_pushed_set(*queued[1:])
 
@@ -378,6 +439,8 @@ class Runner:
             # A software zero took this set, the session is not running, or the step moved on
             # since the set arrived.
             return
+        if result.trigger == "arrival" and (self._arm_pending or result.t_trigger < self._armed_at):
+            return  # the robot came back before this step was armed: not one of its cycles
         item = self._item_or_none()
         if item is None or not handler_for(item.step.kind).takes_sets:
             # Said once per step: a streaming device sends many sets a second, which is
@@ -597,6 +660,7 @@ class Runner:
                 last_hash=self.last_hash,
                 alarms=self._alarm_count,
                 failure=self._failure or "",
+                next_cycle=self._next_cycle,
             )
 
     def prompt(self) -> str:
@@ -618,6 +682,16 @@ class Runner:
     def step_state(self, item: PlanItem) -> dict[str, Any]:
         """A plan item's own mutable state (a handler's counters), kept for the session."""
         return self._step_states.setdefault(item.key, {})
+
+    @property
+    def devices_pace(self) -> bool:
+        """True when the devices decide when a set is taken (push, arrival)."""
+        return self.setup.trigger in DEVICE_DRIVEN_TRIGGERS
+
+    @property
+    def next_cycle(self) -> int:
+        """The number the next recorded cycle gets."""
+        return self._next_cycle
 
     def accepted_in(self, item: PlanItem) -> int:
         """Accepted cycles recorded in a plan item."""
@@ -660,6 +734,7 @@ class Runner:
             by=by,
         )
         self._position += 1
+        self._step_entered()
         self._notify(None)
 
     def take_set(self, timeout: float, by: str) -> CycleOutcome:
@@ -672,7 +747,7 @@ class Runner:
                 if not self._outcome_ready.wait_for(
                     lambda: self._outcomes != seen or self.status != "running", timeout
                 ):
-                    return self.refuse(
+                    outcome = self.refuse(
                         f"No reading set arrived within {timeout:g} s: "
                         + (
                             "press DATA on the gauges (or check the cable)."
@@ -680,6 +755,7 @@ class Runner:
                             else "run the robot's playback (or check the cable)."
                         )
                     )
+                    return replace(outcome, waited=True)
                 if self.status == "failed":
                     self.ensure_open()  # raises the failure's own sentence
                 if self.status != "running" or self._last_outcome is None:

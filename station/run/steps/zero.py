@@ -6,6 +6,11 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from station.errors import StationError
+from station.instruments.zeroing import (
+    DEFAULT_ZERO_READINGS,
+    DEFAULT_ZERO_SETTLE,
+    DEFAULT_ZERO_STILL,
+)
 from station.procedures import StepSchema
 from station.run.state import Action
 from station.run.steps import register
@@ -32,13 +37,23 @@ class ZeroStep(StepHandler):
         run.zero(by=by)
 
     def zero(self, run: Runner, item: PlanItem, by: str, timeout: float) -> None:
-        """A port that is down is waited for until ``timeout``; a gauge reading in another unit
-        than the session's is refused (nothing zeroed)."""
+        """The mean of the step's ``readings`` per channel over its ``settle`` seconds
+        (refused, naming the channel, while a channel's readings spread over more than ``still``
+        resolutions: the robot or a gauge moves). A port that is down is waited for until
+        ``timeout``; a gauge reading in another unit than the session's is refused (nothing
+        zeroed). The event records per channel the method, offset, n, mean, spread, readings
+        and the zero's standard uncertainty."""
+        step = item.step
         with run.lock:
             run.claim()
         try:
             results = run.gauges.zero(
-                list(item.step.channels), timeout, unit=run.setup.resolved_unit
+                list(step.channels),
+                timeout,
+                unit=run.setup.resolved_unit,
+                readings=step.readings or DEFAULT_ZERO_READINGS,
+                settle=step.settle if step.settle is not None else DEFAULT_ZERO_SETTLE,
+                still=step.still if step.still is not None else DEFAULT_ZERO_STILL,
             )
         except StationError as error:
             with run.lock:
@@ -57,7 +72,7 @@ class ZeroStep(StepHandler):
                 step=item.step.id,
                 placement=item.placement,
                 channels={
-                    result.channel: {"method": result.method, "offset": result.offset}
+                    result.channel: {**result.record(), "uncertainty": result.uncertainty}
                     for result in results
                 },
                 by=by,

@@ -1,0 +1,192 @@
+"""``station capture`` paced by the robot (``--trigger arrival`` against ``station simulate
+--cycle-period``) or by the operator (``--every``, Enter), as real subprocesses on real ptys."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from station.instruments.simulator import AxisModel, FixtureModel, GaugeSpec
+from station.session.model import load_session
+
+STATION = [sys.executable, "-m", "station"]
+PERIOD = 0.5
+SEED = 5
+NOISE = 0.01
+"""10 resolutions: every cycle's rest position is told apart from its neighbours'."""
+
+PACED = """\
+id = "paced"
+title = "Cycles paced by the robot"
+version = "1"
+report_section = "2.6"
+channels = ["x", "y", "z"]
+unit = "mm"
+resolution = 0.001
+trigger = "arrival"
+
+[cycles]
+min = 2
+target = 10
+
+[limits]
+tolerance = 0.1
+
+[arrival]
+band = 0.1
+still = 2
+settle = 0.08
+timeout = 1.0
+
+[[steps]]
+id = "ready"
+kind = "check"
+title = "Ready"
+
+[[steps]]
+id = "cycles"
+kind = "cycles"
+title = "Cycles"
+prompt = "Cycle {cycle} of {count}."
+"""
+
+
+@pytest.fixture
+def procedures(tmp_path: Path) -> Path:
+    folder = tmp_path / "procedures"
+    folder.mkdir()
+    (folder / "paced.toml").write_text(PACED)
+    return folder
+
+
+def simulate(*extra: str) -> tuple[subprocess.Popen, str]:
+    """``station simulate`` (Mitutoyo, x y z in mm at 0.001) as a subprocess; its URL."""
+    process = subprocess.Popen(
+        [*STATION, "simulate", "--protocol", "mitutoyo", "--seed", str(SEED)]
+        + ["--noise", str(NOISE), *extra],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    url = process.stdout.readline().strip()
+    if not url:
+        process.kill()
+        pytest.fail(f"no URL: {process.communicate()[1]}")
+    return process, url
+
+
+def stop(process: subprocess.Popen) -> None:
+    process.send_signal(signal.SIGTERM)
+    process.communicate(timeout=10)
+
+
+def capture(*args: str, timeout: float = 90) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [*STATION, "capture", *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        stdin=subprocess.DEVNULL,
+    )
+
+
+def rest_cycle(values: dict[str, float], within: float = 0.0011) -> int:
+    """The simulated robot's cycle whose rest position ``values`` are (within a count: the tail
+    of the settling swing may round one off); fails when none is."""
+    model = FixtureModel(dict.fromkeys("xyz", AxisModel(noise=NOISE)), GaugeSpec(0.001))
+    for cycle in range(200):
+        rest = {c: model.value(c, cycle, SEED) for c in "xyz"}
+        if all(abs(values[c] - rest[c]) <= within for c in rest):
+            return cycle
+    raise AssertionError(f"{values} is no rest position of the robot")
+
+
+def test_arrival_records_ten_cycles_one_per_round_trip_at_rest(
+    tmp_path: Path, procedures: Path
+) -> None:
+    process, url = simulate("--cycle-period", str(PERIOD))
+    try:
+        done = capture(
+            "--procedure", "paced", "--procedures", str(procedures), "--port", url,
+            "--protocol", "mitutoyo", "--map", "1=x,2=y,3=z", "--robot", "R1",
+            "--sessions", str(tmp_path / "s"), "--cycles", "10", "--timeout", "3",
+        )  # fmt: skip
+    finally:
+        stop(process)
+    assert done.returncode == 0, done.stderr
+    session = load_session(next((tmp_path / "s").glob("*.jsonl")))
+    assert session.header["instruments"]["trigger"] == "arrival"  # the procedure's default
+    assert session.header["instruments"]["arrival"] == {
+        "band": 0.1,
+        "still": 2,
+        "settle": 0.08,
+        "timeout": 1.0,
+    }
+    cycles = [session.cycles[n] for n in sorted(session.cycles)]
+    assert len(cycles) == 10
+    # Each set is a rest position of the robot (never the free travel, never mid-swing), of
+    # consecutive round trips: one set per departure, none skipped, none twice.
+    rests = [rest_cycle({c: r.value for c, r in cycle.readings.items()}) for cycle in cycles]
+    assert rests == list(range(rests[0], rests[0] + 10))
+    times = [min(r.t_mono for r in cycle.readings.values()) for cycle in cycles]
+    gaps = [later - earlier for earlier, later in zip(times, times[1:], strict=False)]
+    assert all(PERIOD * 0.7 < gap < PERIOD * 1.3 for gap in gaps), gaps
+
+
+def test_a_return_that_does_not_settle_is_reported_not_recorded(
+    tmp_path: Path, procedures: Path
+) -> None:
+    process, url = simulate("--cycle-period", str(PERIOD), "--hunt", "y=0.01", "--hunt-every", "2")
+    try:
+        done = capture(
+            "--procedure", "paced", "--procedures", str(procedures), "--port", url,
+            "--protocol", "mitutoyo", "--map", "1=x,2=y,3=z", "--robot", "R1",
+            "--sessions", str(tmp_path / "s"), "--cycles", "4", "--timeout", "3",
+        )  # fmt: skip
+    finally:
+        stop(process)
+    assert done.returncode == 0, done.stderr
+    assert "but y was not still" in done.stderr
+    session = load_session(next((tmp_path / "s").glob("*.jsonl")))
+    cycles = [session.cycles[n] for n in sorted(session.cycles)]
+    rests = [rest_cycle({c: r.value for c, r in cycle.readings.items()}) for cycle in cycles]
+    # Every second return hunts on y: those are reported, and only the settled ones recorded.
+    assert len(rests) == 4 and len({rest % 2 for rest in rests}) == 1, rests
+
+
+def test_poll_without_a_pace_is_refused_naming_the_three_choices(tmp_path: Path) -> None:
+    done = capture(
+        "--procedure", "repeatability", "--port", str(tmp_path / "ttyUSB9"), "--protocol",
+        "mitutoyo", "--robot", "R1", "--trigger", "poll", "--sessions", str(tmp_path / "s"),
+    )  # fmt: skip
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1
+    assert "--every" in lines[0] and "terminal" in lines[0] and "arrival" in lines[0]
+    assert not (tmp_path / "s").exists() or not list((tmp_path / "s").glob("*.jsonl"))
+
+
+def test_every_paces_polled_cycles(tmp_path: Path, procedures: Path) -> None:
+    process, url = simulate()
+    try:
+        started = time.monotonic()
+        done = capture(
+            "--procedure", "paced", "--procedures", str(procedures), "--port", url,
+            "--protocol", "mitutoyo", "--map", "1=x,2=y,3=z", "--robot", "R1",
+            "--sessions", str(tmp_path / "s"), "--cycles", "10", "--trigger", "poll",
+            "--every", "0.2",
+        )  # fmt: skip
+        elapsed = time.monotonic() - started
+    finally:
+        stop(process)
+    assert done.returncode == 0, done.stderr
+    session = load_session(next((tmp_path / "s").glob("*.jsonl")))
+    times = [min(r.t_mono for r in session.cycles[n].readings.values()) for n in session.cycles]
+    assert len(times) == 10
+    assert times[-1] - times[0] >= 1.8 - 0.01
+    assert elapsed >= 1.8
