@@ -54,9 +54,10 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
 Keys per step kind, beyond ``id``, ``kind``, ``title`` and ``text``:
 
 - ``input``: ``fields = [{ name, label, type = "number"|"text", unit, required }]``
-- ``zero``: ``channels`` (default: all), ``readings`` (per channel, 2 or more; default 10),
-  ``settle`` (seconds the readings are spread over; default 1.0) and ``still`` (resolutions
-  the readings may spread before a gauge counts as moving and the zero is refused; default 3)
+- ``zero``: ``channels`` (default: all), ``readings`` (per channel, 2 or more: the zero is
+  their mean; without it the gauge's zero command, else one reading set), ``settle`` (seconds
+  the readings are spread over; default 1.0) and ``still`` (resolutions the readings may spread
+  before a gauge counts as moving and the zero is refused; default 3)
 - ``capture``: ``channels`` (default: all the procedure's channels)
 - ``cycles``: ``channels``, ``min``, ``target`` (default: the procedure's cycle counts), ``prompt``
   (shown before each cycle; ``{cycle}`` and ``{count}`` are replaced by plain text substitution)
@@ -82,7 +83,6 @@ from typing import Any, Literal
 from station.errors import StationError
 from station.instruments.arrival import ArrivalConfig
 from station.instruments.zeroing import (
-    DEFAULT_ZERO_READINGS,
     DEFAULT_ZERO_SETTLE,
     DEFAULT_ZERO_STILL,
 )
@@ -238,7 +238,8 @@ class Step:
     options: Mapping[str, Any] = field(default_factory=dict)
     """The values of the keys a registered step kind declares as its own (``schema.keys``)."""
     readings: int | None = None
-    """A ``zero`` step: readings per channel the zero is the mean of (None for other kinds)."""
+    """A ``zero`` step: readings per channel the zero is the mean of (None: the gauge's zero
+    command, else one reading set; always None for other kinds)."""
     settle: float | None = None
     """A ``zero`` step: seconds its readings are spread over."""
     still: float | None = None
@@ -830,7 +831,10 @@ def _parse_step(context: _StepContext, raw: Any, number: str, *, nested: bool = 
             raise check.fail(
                 where, f"'readings' must be 2 or more (a zero is a mean), not {readings}"
             )
-        values["readings"] = readings or DEFAULT_ZERO_READINGS
+        # Without ``readings`` the step zeroes as before this window existed: the gauge's own
+        # zero command, else one reading set (a simulated set-up that counts its readings at
+        # home relies on it); ``settle`` and ``still`` then keep their defaults for the record.
+        values["readings"] = readings
         for key, default in (("settle", DEFAULT_ZERO_SETTLE), ("still", DEFAULT_ZERO_STILL)):
             number = check.number(raw, key, where, required=False)
             if number is not None and not number > 0:

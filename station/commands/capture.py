@@ -23,12 +23,20 @@ procedure's report (the same as ``station analyze FILE``).
 
 Units: the session's unit and gauge resolution are the procedure's unless ``--unit`` and
 ``--resolution`` say otherwise (with another unit than the procedure's, its resolution and
-limits do not apply: give ``--resolution`` and ``--limit`` in that unit). When a port's frames
-say their unit (U-WAVE, CDI, Digimatic, ASCII), one reading set is taken before the session
-file is created (and before a resume is written), and gauges in another unit are refused with
-one line; with ``--trigger push`` that set is the devices' next one (press DATA once, or the
-check waits ``--timeout`` and leaves it to the zero step, which checks too). Frames without a
-unit (Mitutoyo) say nothing: only ``--unit`` can.
+limits do not apply: give ``--resolution`` and ``--limit`` in that unit). Before the session
+file is created (and before a resume is written) a few frames are read and judged
+(:meth:`~station.instruments.gauge.GaugeSet.check_frames`): a unit the frames state (U-WAVE,
+CDI, Digimatic), fewer decimals than the resolution needs, or values off its steps refuse the
+session with one line naming both ("the gauges send steps of 0.001, which is mm on this
+protocol; the session is in inches at 0.0001"); with ``--trigger push`` press DATA once (or
+the check waits ``--timeout`` and leaves it to the zero step, which checks the unit too).
+
+Pacing: ``--trigger poll`` needs ``--every S`` (at least S seconds between two cycles) or a
+terminal (Enter per cycle, after a prompt naming the cycle the file will record); without
+either it is refused before anything is written. ``--trigger arrival`` (the repeatability
+procedure's default on a polled protocol) reads the gauges continuously and takes a set each
+time the robot leaves the fixture and comes back to rest; a return that does not settle is a
+warning on stderr, and nothing is recorded for it.
 
 ``--resume FILE`` continues the session as it was set up: the line (``--port``, ``--protocol``,
 ``--map``) and how this run waits (``--timeout``, ``--attempts``, inputs) may be given; a
@@ -462,6 +470,7 @@ class _Headless:
         self.every = every
         self.enter = enter
         self._last_capture = float("-inf")
+        self._moving_since: float | None = None
         self.inputs = inputs
         self.timeout = timeout
         self.attempts = attempts
@@ -545,10 +554,19 @@ class _Headless:
         try:
             self.runner.zero(by=BY, timeout=self.timeout)
         except GaugesMoving as moving:
-            # The robot is not at rest at the fixture yet: zero once it is (said once).
-            if not self._waiting:
+            # The robot is not at rest at the fixture yet: zero once it is (said once), for as
+            # long as --attempts waits of --timeout; then the run stops, resumable.
+            now = time.monotonic()
+            if self._moving_since is None:
+                self._moving_since = now
                 print(f"station: waiting: {moving.message}", file=sys.stderr, flush=True)
-            self._waiting = True
+            if now - self._moving_since > self.timeout * self.attempts:
+                raise StationError(
+                    f"{moving.message.rstrip('.')} (still moving after "
+                    f"{now - self._moving_since:.0f} s)",
+                    remedy="resume_session",
+                    subject=str(self.runner.path),
+                ) from None
             time.sleep(0.1)
             return
         except StationError:
@@ -557,6 +575,7 @@ class _Headless:
                 return
             raise
         self._waiting = False
+        self._moving_since = None
 
     def _stream(self, state: Any) -> None:
         if state.progress is not None and state.progress.complete:
@@ -665,44 +684,33 @@ class _Printer:
         self._last_warning = None
 
 
-def _check_units(gauges: Any, setup: Any, timeout: float, resume: str | None) -> None:
-    """Take one reading set and refuse, before anything is written, gauges whose frames say
-    they read in another unit than the session's (a frame without a unit says nothing)."""
-    from station.instruments.gauge import unit_mismatch
-
-    if not any(_frames_carry_unit(reader.protocol) for reader in gauges.readers):
-        return  # e.g. Mitutoyo: the frames say nothing, so only --unit can (no set is taken)
+def _check_frames(gauges: Any, setup: Any, timeout: float, resume: str | None) -> None:
+    """Read a few frames and refuse, before anything is written, gauges whose frames disagree
+    with the session's unit or resolution (a unit the frames state, fewer decimals than the
+    resolution needs, values off its steps), with one sentence naming both."""
     if setup.trigger == "push":
         print(
-            f"unit check: press DATA once on the gauges (waiting up to {timeout:g} s)", flush=True
+            f"frames check: press DATA once on the gauges (waiting up to {timeout:g} s)",
+            flush=True,
         )
-    result = gauges.capture(timeout)
-    unit = setup.resolved_unit
-    mismatch = unit_mismatch(result.readings, setup.channels, unit)
-    if not mismatch:
+    problem = gauges.check_frames(
+        setup.resolved_unit, setup.resolved_resolution, timeout=timeout, channels=setup.channels
+    )
+    if not problem:
         return
     if resume:
-        advice = f"switch the gauges to {unit}, then resume again"
+        advice = "set the gauges to the session's unit and resolution, then resume again"
     else:
-        other = next(r.unit for ch, r in result.readings.items() if r.unit != unit)
+        inferred = gauges.infer_frames(setup.channels).values()
+        units = {i.known_unit for i in inferred}
+        steps = {i.step for i in inferred if i.step}
+        unit = next(iter(units)) if len(units) == 1 and None not in units else "U"
+        step = f"{next(iter(steps)):g}" if len(steps) == 1 else "R"
         advice = (
-            f"start it in their unit (--unit {other} with --resolution and --limit in {other}), "
-            f"or switch the gauges to {unit}"
+            f"start it in the gauges' unit and resolution (--unit {unit} --resolution {step}, "
+            f"with --limit in {unit}), or set the gauges to the session's"
         )
-    raise StationError(f"{mismatch}: {advice}; nothing was written")
-
-
-def _frames_carry_unit(protocol: Any) -> bool:
-    """True when the protocol's frames say their unit: a frame it encodes in each unit parses
-    back with that unit (a unit-less frame parses with none)."""
-    from station.procedures import UNITS
-
-    channel = protocol.channels[0]
-    for unit in UNITS:
-        parsed = protocol.parse(protocol.encode(channel, 0.0, 0.001, unit).rstrip(b"\r\n"))
-        if getattr(parsed, "unit", None) != unit:
-            return False
-    return True
+    raise StationError(f"{problem}: {advice}; nothing was written")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -748,7 +756,7 @@ def run(args: argparse.Namespace) -> int:
                 if r.state != "connected"
             )
             raise StationError(f"the gauges did not connect within {timeout:g} s ({problems})")
-        _check_units(gauges, setup, timeout, args.resume)
+        _check_frames(gauges, setup, timeout, args.resume)
         if caught:
             return 128 + caught[0]  # before any session exists: nothing to record
         printer = _Printer(setup.resolved_resolution)

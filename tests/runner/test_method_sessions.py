@@ -44,6 +44,8 @@ def capture(url: str, folder: Path, procedure: str, *extra: str, protocol: str =
         [
             *STATION,
             "capture",
+            "--every",
+            "0.01",
             "--procedure",
             procedure,
             "--port",

@@ -6,11 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from station.errors import StationError
-from station.instruments.zeroing import (
-    DEFAULT_ZERO_READINGS,
-    DEFAULT_ZERO_SETTLE,
-    DEFAULT_ZERO_STILL,
-)
+from station.instruments.zeroing import DEFAULT_ZERO_SETTLE, DEFAULT_ZERO_STILL
 from station.procedures import StepSchema
 from station.run.state import Action
 from station.run.steps import register
@@ -37,7 +33,8 @@ class ZeroStep(StepHandler):
         run.zero(by=by)
 
     def zero(self, run: Runner, item: PlanItem, by: str, timeout: float) -> None:
-        """The mean of the step's ``readings`` per channel over its ``settle`` seconds
+        """The mean of the step's ``readings`` (when it gives them) per channel over its
+        ``settle`` seconds
         (refused, naming the channel, while a channel's readings spread over more than ``still``
         resolutions: the robot or a gauge moves). A port that is down is waited for until
         ``timeout``; a gauge reading in another unit than the session's is refused (nothing
@@ -51,7 +48,7 @@ class ZeroStep(StepHandler):
                 list(step.channels),
                 timeout,
                 unit=run.setup.resolved_unit,
-                readings=step.readings or DEFAULT_ZERO_READINGS,
+                readings=step.readings or 1,
                 settle=step.settle if step.settle is not None else DEFAULT_ZERO_SETTLE,
                 still=step.still if step.still is not None else DEFAULT_ZERO_STILL,
             )
