@@ -226,3 +226,14 @@ def zero_text(channels: Mapping[str, Any], resolution: float | None) -> str:
 
 def _number(value: Any) -> float | None:
     return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else None
+
+
+def zero_taken(zeroes: Iterable[Mapping[str, Any]], resolution: float | None) -> str:
+    """``Zero taken: x +0.0003 (5 readings, spread 0.00010); ...``: the zero in force per
+    channel (each channel's last ``zero`` event), or '' when the session has none."""
+    latest: dict[str, Any] = {}
+    for event in zeroes:
+        channels = event.get("channels") if isinstance(event, Mapping) else None
+        for channel, spec in dict(channels or {}).items():
+            latest[str(channel)] = spec
+    return f"Zero taken: {zero_text(latest, resolution)}" if latest else ""

@@ -867,6 +867,11 @@ def _print_summary(runner: Any, analysis: Any) -> None:
             f"Session file: {runner.path}",
             f"Last line hash (anchors the session file): {runner.last_hash}",
         ]
+        from station.text import zero_taken
+
+        zero = zero_taken([{"channels": runner.recorded_zero}], runner.setup.resolved_resolution)
+        if zero:
+            notes.append(zero)
         if report.analysis is not None:
             print(
                 format_report(

@@ -290,6 +290,7 @@ class Runner:
                     )
                 )
             self._next_cycle = session.next_cycle
+            self._zero_config()
             self._rebuild_live(session)
             self._views = ()
 
@@ -661,6 +662,7 @@ class Runner:
                 alarms=self._alarm_count,
                 failure=self._failure or "",
                 next_cycle=self._next_cycle,
+                zero={channel: dict(zeroed) for channel, zeroed in self.recorded_zero.items()},
             )
 
     def prompt(self) -> str:
@@ -913,6 +915,23 @@ class Runner:
             self._accepted_by_step[key] = self._accepted_by_step.get(key, 0) + 1
         self._accepted_count = len(accepted)
         self._live = self._live.rebuilt([(r.values, r.cycle, r.times) for r in accepted], session)
+
+    def zero_recorded(self, event: Mapping[str, Any]) -> None:
+        """A ``zero`` event is on disk: the zero in force changed, and with it what the
+        analysis takes as the zero's own uncertainty (the live analysis is rebuilt on it, so it
+        stays equal to the batch analysis of the file). Lock held."""
+        for channel, zeroed in dict(event.get("channels") or {}).items():
+            self.recorded_zero[str(channel)] = dict(zeroed)
+        self._zero_config()
+        self._rebuild_live()
+
+    def _zero_config(self) -> None:
+        """The analysis config with the recorded zeros' uncertainties; a new live analysis on
+        it (the caller rebuilds it from the cycles)."""
+        config = analysis_config(self.header, [{"channels": self.recorded_zero}])
+        if config.zero_uncertainty != self.config.zero_uncertainty:
+            self.config = config
+            self._live = self.kind.live(self.config, self.setup.channels, self.header)
 
     def _item_or_none(self) -> PlanItem | None:
         return self._plan[self._position] if self._position < len(self._plan) else None

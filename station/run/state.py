@@ -217,6 +217,9 @@ class RunnerState:
     failure: str = ""
     """Why the session failed (status ``failed``: a write failed, e.g. the disk is full);
     empty otherwise."""
+    zero: Mapping[str, Any] = field(default_factory=dict)
+    """The zero in force per channel: its last ``zero`` event's entry (method, offset, n,
+    mean, spread...)."""
     next_cycle: int = 1
     """The number the next recorded cycle gets (numbering runs over the whole session and
     skips nothing: a rejected cycle keeps its number)."""

@@ -64,7 +64,7 @@ class ZeroStep(StepHandler):
         with run.lock:
             run.release()
             run.ensure_open()
-            run.append(
+            event = run.append(
                 "zero",
                 step=item.step.id,
                 placement=item.placement,
@@ -74,6 +74,7 @@ class ZeroStep(StepHandler):
                 },
                 by=by,
             )
+            run.zero_recorded(event)
             run.complete_step(item, by)
 
 
