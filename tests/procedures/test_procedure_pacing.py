@@ -9,7 +9,7 @@ import pytest
 
 from station.errors import StationError
 from station.instruments.arrival import ArrivalConfig
-from station.procedures import builtin_procedures_dir, load_procedure
+from station.procedures import load_procedure
 
 HEAD = """
 id = "probe"
@@ -72,12 +72,3 @@ def test_faults_name_the_file_and_the_place(tmp_path: Path, extra, zero_extra, f
     with pytest.raises(StationError, match=fault) as caught:
         load_procedure(path)
     assert str(path) in caught.value.message
-
-
-def test_the_repeatability_procedure_zeroes_from_several_readings() -> None:
-    # The other built-in procedures' simulated set-ups (two fixtures, the bar, the joints, the
-    # gauge bench) count one reading at home per zero: they keep one until their models hold
-    # still there.
-    procedure = load_procedure(builtin_procedures_dir() / "repeatability.toml")
-    zeros = [step for step in procedure.all_steps() if step.kind == "zero"]
-    assert zeros and all(step.readings and step.readings > 1 for step in zeros)

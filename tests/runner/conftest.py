@@ -4,7 +4,6 @@ gauge set reading it, both in this process."""
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -29,14 +28,8 @@ def make_simulator(seed: int = 7, faults: Faults | None = None, push_rate: float
 
 
 def repeatability() -> Procedure:
-    """The built-in repeatability procedure, its zero from one reading set: the static
-    simulator shows a new rest position at every reading (a robot that never stands still),
-    which a zero from several readings rightly refuses."""
-    procedure = discover_procedures(use_env=False).get("repeatability")
-    steps = tuple(
-        replace(step, readings=None) if step.kind == "zero" else step for step in procedure.steps
-    )
-    return replace(procedure, steps=steps)
+    """The built-in repeatability procedure."""
+    return discover_procedures(use_env=False).get("repeatability")
 
 
 @pytest.fixture

@@ -274,18 +274,11 @@ sys.exit(main(sys.argv[1:]))
 
 
 def test_a_crash_in_the_capture_thread_interrupts_the_session(simulator, tmp_path):
-    # The static simulator shows a new rest position at every reading: a site copy of the
-    # repeatability procedure zeroes it from one reading set.
-    site = tmp_path / "procedures"
-    site.mkdir()
-    builtin = (REPO / "procedures" / "repeatability.toml").read_text()
-    (site / "repeatability.toml").write_text(builtin.replace("readings = 5\n", ""))
     # A bug injected on purpose (the third capture raises): no real part fails on demand.
     done = subprocess.run(
         [sys.executable, "-c", CRASHING, "capture", "--procedure", "repeatability",
          "--port", simulator.url, "--protocol", "mitutoyo", "--robot", "r",
-         "--sessions", str(tmp_path), "--cycles", "30", "--trigger", "poll", "--every", "0.01",
-         "--procedures", str(site)],
+         "--sessions", str(tmp_path), "--cycles", "30", "--trigger", "poll", "--every", "0.01"],
         capture_output=True, text=True, cwd=REPO, timeout=60,
         env={**os.environ, "STATION_PROCEDURES": ""},
     )  # fmt: skip

@@ -16,6 +16,8 @@ if TYPE_CHECKING:
     from station.run.engine import Runner
 
 ZERO_TIMEOUT = 5.0
+ARRIVAL_ZERO_READINGS = 5
+"""Readings per channel of a zero step without ``readings`` under the ``arrival`` trigger."""
 
 
 class ZeroStep(StepHandler):
@@ -31,6 +33,14 @@ class ZeroStep(StepHandler):
     def confirm(self, run: Runner, item: PlanItem, by: str) -> None:
         # Confirming a zero step is zeroing: the engine releases its lock for the wait.
         run.zero(by=by)
+
+    @staticmethod
+    def default_readings(run: Runner) -> int:
+        """Readings per channel when the step does not say: with the ``arrival`` trigger the
+        robot is known to move between cycles, so the zero is a mean taken while every gauge
+        is still (a single reading could be taken mid-travel); otherwise one reading set (or
+        the gauge's own zero command), as before zero windows existed."""
+        return ARRIVAL_ZERO_READINGS if run.setup.trigger == "arrival" else 1
 
     def zero(self, run: Runner, item: PlanItem, by: str, timeout: float) -> None:
         """The mean of the step's ``readings`` (when it gives them) per channel over its
@@ -48,7 +58,7 @@ class ZeroStep(StepHandler):
                 list(step.channels),
                 timeout,
                 unit=run.setup.resolved_unit,
-                readings=step.readings or 1,
+                readings=step.readings or self.default_readings(run),
                 settle=step.settle if step.settle is not None else DEFAULT_ZERO_SETTLE,
                 still=step.still if step.still is not None else DEFAULT_ZERO_STILL,
             )
