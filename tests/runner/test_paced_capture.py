@@ -214,3 +214,56 @@ def test_a_mm_simulator_against_an_inch_session_is_refused_naming_both(tmp_path:
     ) in done.stderr
     assert "--unit mm --resolution 0.001" in done.stderr
     assert not (tmp_path / "s").exists() or not list((tmp_path / "s").glob("*.jsonl"))
+
+
+def test_at_a_terminal_poll_waits_for_enter_before_each_cycle(
+    tmp_path: Path, procedures: Path
+) -> None:
+    import os
+    import pty
+
+    process, url = simulate()
+    master, slave = pty.openpty()
+    try:
+        capture_process = subprocess.Popen(
+            [*STATION, "capture", "--procedure", "paced", "--procedures", str(procedures),
+             "--port", url, "--protocol", "mitutoyo", "--map", "1=x,2=y,3=z", "--robot", "R1",
+             "--sessions", str(tmp_path / "s"), "--cycles", "3", "--trigger", "poll"],
+            stdin=slave, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        os.close(slave)
+        prompts = []
+        for _ in range(3):
+            line = capture_process.stderr.readline()
+            while "[Enter]" not in line:
+                assert line, "the capture ended before asking for Enter"
+                line = capture_process.stderr.readline()
+            prompts.append(line.strip())
+            # Nothing is captured before Enter.
+            time.sleep(0.3)
+            assert len(_events(tmp_path)) == len(prompts) - 1
+            os.write(master, b"\n")
+            _wait_for_cycles(tmp_path, len(prompts))
+        out, err = capture_process.communicate(timeout=60)
+    finally:
+        os.close(master)
+        stop(process)
+    assert capture_process.returncode == 0, err
+    assert prompts == [f"Cycle {n} of 3.  [Enter]" for n in (1, 2, 3)]
+
+
+def _events(tmp_path: Path) -> list[str]:
+    import json
+
+    files = list((tmp_path / "s").glob("*.jsonl")) if (tmp_path / "s").exists() else []
+    if not files:
+        return []
+    lines = files[0].read_text().splitlines()[1:]
+    return [line for line in lines if json.loads(line).get("type") == "reading"]
+
+
+def _wait_for_cycles(tmp_path: Path, count: int) -> None:
+    deadline = time.monotonic() + 15
+    while len(_events(tmp_path)) < count:
+        assert time.monotonic() < deadline, f"cycle {count} was not recorded"
+        time.sleep(0.05)
