@@ -27,6 +27,12 @@ line while the disk syncs). A pushed set becomes a cycle while the step that was
 it arrived still is and takes sets. A capture, zero or stroke records only into the step it
 was started in.
 
+With the ``arrival`` trigger the engine also hears the robot's going and coming (said as
+information; a return that did not settle as a warning, never recorded), and arms the gauges
+each time a step that takes sets becomes current (its handler's ``entered``): a round trip under
+way before that step is not one of its cycles. A ``zero`` event updates the zero uncertainty
+the analysis weighs an offset from nominal against.
+
 A resumed session puts the recorded zero back on the gauges (each channel's last ``zero``
 event). A failed write (a full disk) makes the engine ``failed``; every later action raises the
 journal's own sentence (:attr:`Runner.failure`).
