@@ -693,8 +693,13 @@ def _check_frames(gauges: Any, setup: Any, timeout: float, resume: str | None) -
             f"frames check: press DATA once on the gauges (waiting up to {timeout:g} s)",
             flush=True,
         )
+    # One reading set: its frames show the decimals and any unit the gauges state.
     problem = gauges.check_frames(
-        setup.resolved_unit, setup.resolved_resolution, timeout=timeout, channels=setup.channels
+        setup.resolved_unit,
+        setup.resolved_resolution,
+        readings=1,
+        timeout=timeout,
+        channels=setup.channels,
     )
     if not problem:
         return

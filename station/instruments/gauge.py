@@ -1303,7 +1303,20 @@ class GaugeSet:
         every kept frame. A channel that sent nothing says nothing.
         """
         wanted = list(self.channels if channels is None else channels)
-        self.collect(wanted, readings, 0.0, timeout)
+        if self.trigger in ("poll", "stable") and all(
+            self._reader_of[c].protocol.polled for c in wanted
+        ):
+            # One request per reading, each answered before the next: the gauges are asked
+            # exactly ``readings`` times (a device, or a simulated robot, that counts its
+            # readings sees a known number).
+            deadline = time.monotonic() + timeout
+            for _ in range(readings):
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    break
+                self._capture_poll(remaining)
+        else:
+            self.collect(wanted, readings, 0.0, timeout)
         samples = self.frame_samples(wanted)
         inferred = {
             c: infer_channel(c, samples[c], self._reader_of[c].protocol.units_by_decimals)

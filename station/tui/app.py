@@ -259,6 +259,7 @@ class StationApp(App[int]):
         problem = self.gauges.check_frames(
             setup.resolved_unit,
             setup.resolved_resolution,
+            readings=1,  # one reading set: its frames show the decimals and a stated unit
             timeout=FRAMES_TIMEOUT,
             channels=setup.channels,
         )

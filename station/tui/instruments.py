@@ -228,7 +228,8 @@ def test_connection(
             lines = [*lines, f"  {number}: {values or 'no reading'}{note}"]
             yield lines
         if unit is not None and resolution is not None:
-            problem = gauges.check_frames(unit, resolution, timeout=timeout)
+            # The frames of the sets just shown (no more readings are taken).
+            problem = gauges.check_frames(unit, resolution, readings=0, timeout=timeout)
             if problem:
                 raise StationError(
                     f"The line works, but {problem}: set the unit and resolution to the "
