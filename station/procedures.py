@@ -23,6 +23,10 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
     min = 25
     target = 30
 
+    trigger = "arrival"             # optional: the trigger a session takes by default where
+                                    # the gauges can be read continuously (a polled protocol):
+                                    # poll, push, stable or arrival; else poll
+
     [arrival]                       # optional: the arrival trigger (cycles paced by the robot)
     band = 0.01                     # a channel farther than this from its zero has left the
                                     # fixture (in `unit`; default 100 x the gauge resolution)
@@ -50,9 +54,10 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
 Keys per step kind, beyond ``id``, ``kind``, ``title`` and ``text``:
 
 - ``input``: ``fields = [{ name, label, type = "number"|"text", unit, required }]``
-- ``zero``: ``channels`` (default: all), ``readings`` (per channel, 2 or more; default 10),
-  ``settle`` (seconds the readings are spread over; default 1.0) and ``still`` (resolutions
-  the readings may spread before a gauge counts as moving and the zero is refused; default 3)
+- ``zero``: ``channels`` (default: all), ``readings`` (per channel, 2 or more: the zero is
+  their mean; without it the gauge's zero command, else one reading set), ``settle`` (seconds
+  the readings are spread over; default 1.0) and ``still`` (resolutions the readings may spread
+  before a gauge counts as moving and the zero is refused; default 3)
 - ``capture``: ``channels`` (default: all the procedure's channels)
 - ``cycles``: ``channels``, ``min``, ``target`` (default: the procedure's cycle counts), ``prompt``
   (shown before each cycle; ``{cycle}`` and ``{count}`` are replaced by plain text substitution)
@@ -78,7 +83,6 @@ from typing import Any, Literal
 from station.errors import StationError
 from station.instruments.arrival import ArrivalConfig
 from station.instruments.zeroing import (
-    DEFAULT_ZERO_READINGS,
     DEFAULT_ZERO_SETTLE,
     DEFAULT_ZERO_STILL,
 )
@@ -266,7 +270,8 @@ class Step:
     options: Mapping[str, Any] = field(default_factory=dict)
     """The values of the keys a registered step kind declares as its own (``schema.keys``)."""
     readings: int | None = None
-    """A ``zero`` step: readings per channel the zero is the mean of (None for other kinds)."""
+    """A ``zero`` step: readings per channel the zero is the mean of (None: the gauge's zero
+    command, else one reading set; always None for other kinds)."""
     settle: float | None = None
     """A ``zero`` step: seconds its readings are spread over."""
     still: float | None = None
@@ -309,6 +314,9 @@ class Procedure:
     """How its sessions are analysed: the file's ``analysis``, else by its steps."""
     arrival: ArrivalConfig = field(default_factory=ArrivalConfig)
     """The ``arrival`` trigger's parameters: the file's ``[arrival]``, else the defaults."""
+    trigger: str | None = None
+    """The trigger its sessions take by default where the gauges can be read continuously (the
+    file's ``trigger``); None: poll."""
     causes: tuple[str, ...] = DEFAULT_CAUSES
     """The assignable causes an alarm is acknowledged with; "other" (with a text) is last."""
 
@@ -488,6 +496,7 @@ _TOP_KEYS = (
     "causes",
     "steps",
     "arrival",
+    "trigger",
 )
 _COMMON_STEP_KEYS = ("id", "kind", "title", "text")
 _FIELD_KEYS = ("name", "label", "type", "unit", "required")
@@ -593,6 +602,12 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
 
     limits = _parse_limits(check, check.get(table, "limits", dict, "", required=False), channels)
     arrival = _parse_arrival(check, check.get(table, "arrival", dict, "", required=False))
+    trigger = check.get(table, "trigger", str, "", required=False)
+    if trigger is not None:
+        from station.instruments.gauge import TRIGGERS
+
+        if trigger not in TRIGGERS:
+            raise check.fail("", f"'trigger' must be one of {', '.join(TRIGGERS)}, not {trigger!r}")
 
     raw_steps = check.get(table, "steps", list, "")
     if not raw_steps:
@@ -620,6 +635,7 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
         sha256=hashlib.sha256(data).hexdigest(),
         analysis=analysis,
         arrival=arrival,
+        trigger=trigger,
         causes=causes,
     )
 
@@ -824,7 +840,10 @@ def _parse_step(context: _StepContext, raw: Any, number: str, *, nested: bool = 
             raise check.fail(
                 where, f"'readings' must be 2 or more (a zero is a mean), not {readings}"
             )
-        values["readings"] = readings or DEFAULT_ZERO_READINGS
+        # Without ``readings`` the step zeroes as before this window existed: the gauge's own
+        # zero command, else one reading set (a simulated set-up that counts its readings at
+        # home relies on it); ``settle`` and ``still`` then keep their defaults for the record.
+        values["readings"] = readings
         for key, default in (("settle", DEFAULT_ZERO_SETTLE), ("still", DEFAULT_ZERO_STILL)):
             number = check.number(raw, key, where, required=False)
             if number is not None and not number > 0:

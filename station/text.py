@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from decimal import Decimal
 from typing import Any
@@ -242,3 +242,39 @@ def limits_text(lsl: float | None, usl: float | None, nominal: float | None = No
     if lsl is not None and usl is not None and math.isclose(-lsl, usl) and not nominal:
         return f"±{usl:g}"
     return f"{'' if lsl is None else f'{lsl:g}'}:{'' if usl is None else f'{usl:g}'}"
+
+
+def zero_text(channels: Mapping[str, Any], resolution: float | None) -> str:
+    """A zero event's channels in one line: ``x +0.0003 (10 readings, spread 0.0001)`` each
+    (the offset subtracted from later readings; ``device`` when the gauge zeroed itself), or
+    ``x +0.0003 (1 reading)`` for an old one-reading zero."""
+    parts = []
+    for channel, spec in channels.items():
+        spec = spec if isinstance(spec, Mapping) else {}
+        n = spec.get("n")
+        if spec.get("method") == "device":
+            shown = "device zero"
+        else:
+            shown = format_value(_number(spec.get("offset")), resolution)
+        if isinstance(n, int) and n > 1:
+            spread = format_spread(_number(spec.get("spread")), resolution)
+            detail = f"{n} readings, spread {spread}"
+        else:
+            detail = "1 reading"
+        parts.append(f"{channel} {shown} ({detail})")
+    return "; ".join(parts)
+
+
+def _number(value: Any) -> float | None:
+    return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else None
+
+
+def zero_taken(zeroes: Iterable[Mapping[str, Any]], resolution: float | None) -> str:
+    """``Zero taken: x +0.0003 (5 readings, spread 0.00010); ...``: the zero in force per
+    channel (each channel's last ``zero`` event), or '' when the session has none."""
+    latest: dict[str, Any] = {}
+    for event in zeroes:
+        channels = event.get("channels") if isinstance(event, Mapping) else None
+        for channel, spec in dict(channels or {}).items():
+            latest[str(channel)] = spec
+    return f"Zero taken: {zero_text(latest, resolution)}" if latest else ""

@@ -47,6 +47,7 @@ from station.session.alarms import (
 from station.session.gauge_register import coverage_fields, gauge_block
 from station.session.header import analysis_config
 from station.session.model import Session, load_session
+from station.text import zero_taken
 
 AccuracyInputs = tuple[np.ndarray, dict[str, np.ndarray], dict[int, tuple[float, ...]]]
 """Placement of each reading, the errors x, y, z, and the pendant coordinates per placement."""
@@ -292,6 +293,9 @@ def session_source(session: Session) -> SessionSource:
         f"created {session.created}, {session.status}.",
         f"Last line hash (anchors the session file): {session.last_hash}",
     ]
+    zero = zero_taken(session.zeroes, session.header.get("resolution"))
+    if zero:
+        notes.append(zero)
     if session.torn is not None:
         notes.append(f"Torn tail: {session.torn.message}")
     channels, cycles = accepted_readings(session)
@@ -301,7 +305,7 @@ def session_source(session: Session) -> SessionSource:
         cycles=cycles,
         excluded_cycles=tuple(session.excluded_cycles),
         # The same settings the live analysis of the running session used.
-        config=analysis_config(session.header),
+        config=analysis_config(session.header, session.zeroes),
         notes=tuple(notes),
         analysis=session_analysis(session),
         times={name: times for name, times in session.channel_times().items() if name in channels},
@@ -746,7 +750,7 @@ def analyze_session(session: Session) -> Analysis | None:
     times = session.channel_times()
     return analyze(
         channels,
-        analysis_config(session.header),
+        analysis_config(session.header, session.zeroes),
         excluded_cycles=session.excluded_cycles,
         cycles=cycles,
         times={name: times[name] for name in channels},

@@ -68,14 +68,34 @@ def t_quantile(p: float, degrees: int) -> float:
 
 def offset_is_clear(descriptive: Descriptive, nominal: float) -> bool:
     """True when the mean differs from nominal beyond its two-sided 95 % t-interval."""
-
     if descriptive.n < 2 or descriptive.mean is None or descriptive.sd is None:
         return False
     offset = abs(descriptive.mean - nominal)
     if descriptive.sd == 0.0:
         return offset > 0.0
-    half_width = t_quantile(0.975, descriptive.n - 1) * descriptive.sd / math.sqrt(descriptive.n)
-    return offset > half_width
+    return offset > _mean_half_width(descriptive)
+
+
+def _mean_half_width(descriptive: Descriptive) -> float:
+    """The half-width of the mean's two-sided 95 % t-interval."""
+    if descriptive.sd is None or descriptive.n < 2:
+        return 0.0
+    return t_quantile(0.975, descriptive.n - 1) * descriptive.sd / math.sqrt(descriptive.n)
+
+
+ZERO_COVERAGE = 2.0
+"""Coverage factor on the zero's standard uncertainty (about 95 %)."""
+
+
+def zero_explains(descriptive: Descriptive, nominal: float, zero_uncertainty: float) -> bool:
+    """True when the mean's offset from nominal lies within what the readings' own scatter and
+    the zero's uncertainty together explain: every reading was shifted by the zero taken, so
+    an offset of the zero's size is no evidence against the robot."""
+    if descriptive.mean is None:
+        return False
+    offset = abs(descriptive.mean - nominal)
+    combined = math.hypot(_mean_half_width(descriptive), ZERO_COVERAGE * zero_uncertainty)
+    return offset <= combined
 
 
 def channel_hints(
@@ -88,8 +108,11 @@ def channel_hints(
     nominal: float,
     resolution: float | None,
     unit: str = "",
+    zero_uncertainty: float | None = None,
 ) -> list[str]:
-    """The hints for one channel, each a sentence naming the channel and the figure."""
+    """The hints for one channel, each a sentence naming the channel and the figure.
+    ``zero_uncertainty``: the standard uncertainty of the zero the readings are taken from (an
+    offset it explains is said to be the zero's, not the robot's)."""
     hints: list[str] = []
     skew = descriptive.skewness
     if skew is not None and abs(skew) >= SKEW_HINT:
@@ -103,12 +126,26 @@ def channel_hints(
         offset = descriptive.mean - nominal
         # "off nominal (+0 in)" reads oddly; the nominal is named only when it is not zero.
         where = "off nominal" if nominal == 0 else f"off the nominal {_figure(nominal, unit)}"
-        hints.append(
-            f"{name}: the average is {_figure(offset, unit)} {where}, "
-            f"more than chance explains with {descriptive.n} "
-            "readings; the report attributes this to the linearisation of the inverse "
-            "kinematics or to the ambient temperature."
+        zero = (
+            f"±{ZERO_COVERAGE * zero_uncertainty:.2g} {unit}".rstrip()
+            if zero_uncertainty is not None
+            else ""
         )
+        if zero_uncertainty is not None and zero_explains(descriptive, nominal, zero_uncertainty):
+            hints.append(
+                f"{name}: the average is {_figure(offset, unit)} {where}, within what the "
+                f"zero's own uncertainty ({zero}) explains: every reading carries the zero "
+                "taken, so zero again from more readings (the robot still at the fixture) "
+                "before blaming the robot."
+            )
+        else:
+            beyond = f", beyond the zero's own uncertainty ({zero})" if zero else ""
+            hints.append(
+                f"{name}: the average is {_figure(offset, unit)} {where}, "
+                f"more than chance explains with {descriptive.n} readings{beyond}; the report "
+                "attributes this to the linearisation of the inverse kinematics or to the "
+                "ambient temperature."
+            )
     threshold = capability.threshold
     if (
         capability.cp is not None

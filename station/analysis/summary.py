@@ -79,6 +79,9 @@ class AnalysisConfig:
     """Chart points after which the live (phase II) limits freeze; None: no live limits."""
     baseline: ControlBaseline | None = None
     """Fixed phase II limits per channel (a robot's baseline); they replace the freeze."""
+    zero_uncertainty: Mapping[str, float] = field(default_factory=dict)
+    """The standard uncertainty of the zero in force per channel (from the session's zero
+    events): an offset from nominal within what it explains is said to be the zero's."""
 
     def __post_init__(self) -> None:
         if self.resolution is not None and not self.resolution > 0:
@@ -428,6 +431,7 @@ def hints_of(channels: Sequence[ChannelAnalysis], config: AnalysisConfig) -> tup
                 nominal=channel.nominal,
                 resolution=config.resolution,
                 unit=config.unit,
+                zero_uncertainty=config.zero_uncertainty.get(channel.name),
             )
         )
         hints.extend(diagnostic_hints(channel))

@@ -23,12 +23,20 @@ procedure's report (the same as ``station analyze FILE``).
 
 Units: the session's unit and gauge resolution are the procedure's unless ``--unit`` and
 ``--resolution`` say otherwise (with another unit than the procedure's, its resolution and
-limits do not apply: give ``--resolution`` and ``--limit`` in that unit). When a port's frames
-say their unit (U-WAVE, CDI, Digimatic, ASCII), one reading set is taken before the session
-file is created (and before a resume is written), and gauges in another unit are refused with
-one line; with ``--trigger push`` that set is the devices' next one (press DATA once, or the
-check waits ``--timeout`` and leaves it to the zero step, which checks too). Frames without a
-unit (Mitutoyo) say nothing: only ``--unit`` can.
+limits do not apply: give ``--resolution`` and ``--limit`` in that unit). Before the session
+file is created (and before a resume is written) a few frames are read and judged
+(:meth:`~station.instruments.gauge.GaugeSet.check_frames`): a unit the frames state (U-WAVE,
+CDI, Digimatic), fewer decimals than the resolution needs, or values off its steps refuse the
+session with one line naming both ("the gauges send steps of 0.001, which is mm on this
+protocol; the session is in inches at 0.0001"); with ``--trigger push`` press DATA once (or
+the check waits ``--timeout`` and leaves it to the zero step, which checks the unit too).
+
+Pacing: ``--trigger poll`` needs ``--every S`` (at least S seconds between two cycles) or a
+terminal (Enter per cycle, after a prompt naming the cycle the file will record); without
+either it is refused before anything is written. ``--trigger arrival`` (the repeatability
+procedure's default on a polled protocol) reads the gauges continuously and takes a set each
+time the robot leaves the fixture and comes back to rest; a return that does not settle is a
+warning on stderr, and nothing is recorded for it.
 
 ``--resume FILE`` continues the session as it was set up: the line (``--port``, ``--protocol``,
 ``--map``) and how this run waits (``--timeout``, ``--attempts``, inputs) may be given; a
@@ -54,6 +62,7 @@ import getpass
 import signal
 import sys
 import threading
+import time
 from pathlib import Path
 from typing import Any
 
@@ -120,9 +129,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--trigger",
-        choices=("poll", "push", "stable"),
-        help="poll: ask the gauges; push: they send (DATA button, foot switch); stable: take "
-        "the set once it settles (default poll)",
+        choices=("poll", "push", "stable", "arrival"),
+        help="poll: ask the gauges (paced by --every or Enter); push: they send (DATA button, "
+        "foot switch); stable: take the set once it settles; arrival: read continuously and "
+        "take a set each time the robot leaves and comes back to rest (default: the "
+        "procedure's trigger for a polled protocol, else poll)",
+    )
+    parser.add_argument(
+        "--every",
+        metavar="S",
+        help="poll: at least S seconds between two cycles (without it, and without a "
+        "terminal to press Enter in, poll is refused)",
     )
     parser.add_argument(
         "--map", metavar="1=x,2=y,3=z", help="device to station channels (default 1, 2, 3 ...)"
@@ -303,7 +320,7 @@ def _setup(args: argparse.Namespace) -> Any:
         robot=args.robot,
         operator=args.operator if args.operator is not None else getpass.getuser(),
         ports=(PortSetup(args.port, args.protocol, _channel_map(args, procedure.channels)),),
-        trigger=args.trigger or "poll",
+        trigger=args.trigger or default_trigger(procedure, args.protocol),
         unit=args.unit,
         resolution=resolution,
         limits=limits or None,
@@ -328,6 +345,17 @@ def _gauges(items: list[str], channels: tuple[str, ...]) -> dict[str, str]:
             )
         gauges[channel.strip()] = gauge.strip()
     return gauges
+
+
+def default_trigger(procedure: Any, protocol: str) -> str:
+    """The trigger of a session without ``--trigger``: the procedure's own (the repeatability
+    procedure declares ``arrival``) where the gauges can be read continuously (a polled
+    protocol), else ``poll``."""
+    from station.instruments.protocols import get_protocol
+
+    if procedure.trigger and get_protocol(protocol).polled:
+        return str(procedure.trigger)
+    return "poll"
 
 
 def _channel_map(args: argparse.Namespace, channels: tuple[str, ...]) -> dict[str, str]:
@@ -407,6 +435,27 @@ def _resume_conflicts(args: argparse.Namespace, setup: Any) -> list[str]:
     return conflicts
 
 
+def _pacing(trigger: str, every_text: str | None) -> tuple[float | None, bool]:
+    """How a ``poll`` session paces its cycles: (``--every`` seconds, Enter at the terminal).
+    Without either, polling would record a cycle as fast as the gauges answer (a gauge standing
+    still, not a robot repeating): refused with the three ways to pace it."""
+    every = _positive(every_text, "--every") if every_text is not None else None
+    if every is not None and trigger in ("push", "arrival"):
+        who = "gauges" if trigger == "push" else "robot"
+        raise StationError(
+            f"--every paces --trigger poll; with --trigger {trigger} the {who} set the pace: "
+            "leave --every out"
+        )
+    if trigger != "poll" or every is not None:
+        return every, False
+    if sys.stdin is not None and sys.stdin.isatty():
+        return None, True
+    raise StationError(
+        "--trigger poll needs a pace: --every S (seconds between cycles), a terminal to press "
+        "Enter in for each cycle, or --trigger push or arrival (the gauges or the robot set it)"
+    )
+
+
 def _check_answerable(runner_plan: Any, procedure: Any, inputs: Inputs, done: set) -> None:
     """Refuse, before anything is written, a procedure this command cannot walk alone
     (``runner_plan``: the unrolled steps as (step, placement); ``done``: the (step id,
@@ -449,8 +498,14 @@ class _Headless:
         *,
         deadband: float | None = None,
         still: float = 2.0,
+        every: float | None = None,
+        enter: bool = False,
     ) -> None:
         self.runner = runner
+        self.every = every
+        self.enter = enter
+        self._last_capture = float("-inf")
+        self._moving_since: float | None = None
         self.inputs = inputs
         self.timeout = timeout
         self.attempts = attempts
@@ -479,15 +534,34 @@ class _Headless:
         return sum(reader.reading_count for reader in getattr(self.runner.gauges, "readers", ()))
 
     def _idle(self, step: Any) -> None:
-        """Nobody pressed DATA during a wait: say once, until the next reading, that the
-        command waits for them (push: the operator sets the pace)."""
+        """Nobody pressed DATA (or the robot did not come back) during a wait: say once, until
+        the next set, that the command waits (the operator or the robot sets the pace)."""
         if not self._waiting:
+            what = "press DATA" if self.push else "run the robot's playback loop"
             print(
-                f"station: waiting for the gauges: press DATA (step {step.title!r})",
+                f"station: waiting for the gauges: {what} (step {step.title!r})",
                 file=sys.stderr,
                 flush=True,
             )
         self._waiting = True
+
+    def _pace(self, state: Any) -> bool:
+        """Poll: wait out ``--every`` since the last capture, or for Enter at the terminal
+        (after the prompt naming the cycle the file will record). False when the walk should
+        look at the state again first (the session changed meanwhile)."""
+        if self.every is not None:
+            delay = self._last_capture + self.every - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
+        elif self.enter:
+            print(f"{state.action.prompt}  [Enter]", file=sys.stderr, flush=True)
+            if not sys.stdin.readline():
+                raise StationError(
+                    "standard input closed while waiting for Enter: resume the session "
+                    "with --every S to pace its cycles without a terminal"
+                )
+        self._last_capture = time.monotonic()
+        return self.runner.state().status == "running"
 
     def _walk(self) -> None:
         """Do what the engine asks next until every step is done: one small call per action
@@ -509,15 +583,34 @@ class _Headless:
         self.runner.submit_input({f.name: given[f.name] for f in fields if f.name in given}, by=BY)
 
     def _zero(self, state: Any) -> None:
+        from station.instruments.zeroing import GaugesMoving
+
         seen = self._readings_seen()
         try:
             self.runner.zero(by=BY, timeout=self.timeout)
+        except GaugesMoving as moving:
+            # The robot is not at rest at the fixture yet: zero once it is (said once), for as
+            # long as --attempts waits of --timeout; then the run stops, resumable.
+            now = time.monotonic()
+            if self._moving_since is None:
+                self._moving_since = now
+                print(f"station: waiting: {moving.message}", file=sys.stderr, flush=True)
+            if now - self._moving_since > self.timeout * self.attempts:
+                raise StationError(
+                    f"{moving.message.rstrip('.')} (still moving after "
+                    f"{now - self._moving_since:.0f} s)",
+                    remedy="resume_session",
+                    subject=str(self.runner.path),
+                ) from None
+            time.sleep(0.1)
+            return
         except StationError:
             if self.push and self._readings_seen() == seen:
                 self._idle(state.current.step)  # nobody pressed DATA yet: the zero waits
                 return
             raise
         self._waiting = False
+        self._moving_since = None
 
     def _stream(self, state: Any) -> None:
         if state.progress is not None and state.progress.complete:
@@ -536,12 +629,17 @@ class _Headless:
         if state.progress is not None and state.progress.complete:
             runner.confirm(by=BY)
             return
+        if not self._pace(state):
+            return
         seen = self._readings_seen()
         outcome = runner.capture(self.timeout, by=BY)
         if runner.state().status != "running":
             return
         if outcome.recorded:
             self._refused = 0
+        elif outcome.waited and not self.push:
+            self._idle(state.current.step)  # the robot has not come back yet: it sets the pace
+            return
         elif self.push and self._readings_seen() == seen:
             self._idle(state.current.step)  # no reading at all: nobody pressed DATA yet
             return
@@ -606,8 +704,9 @@ class _Printer:
         elif kind == "step":
             self._print(f"step {event['step']}: done (by {event.get('by', 'operator')})")
         elif kind == "zero":
-            zeroed = ", ".join(f"{ch} ({spec['method']})" for ch, spec in event["channels"].items())
-            self._print(f"zeroed {zeroed}")
+            from station.text import zero_text
+
+            self._print("zeroed " + zero_text(event["channels"], self.resolution))
         elif kind == "alarm":
             from station.session.alarms import recorded_alarm
 
@@ -702,44 +801,38 @@ def acknowledge_at_terminal(
     return done
 
 
-def _check_units(gauges: Any, setup: Any, timeout: float, resume: str | None) -> None:
-    """Take one reading set and refuse, before anything is written, gauges whose frames say
-    they read in another unit than the session's (a frame without a unit says nothing)."""
-    from station.instruments.gauge import unit_mismatch
-
-    if not any(_frames_carry_unit(reader.protocol) for reader in gauges.readers):
-        return  # e.g. Mitutoyo: the frames say nothing, so only --unit can (no set is taken)
+def _check_frames(gauges: Any, setup: Any, timeout: float, resume: str | None) -> None:
+    """Read a few frames and refuse, before anything is written, gauges whose frames disagree
+    with the session's unit or resolution (a unit the frames state, fewer decimals than the
+    resolution needs, values off its steps), with one sentence naming both."""
     if setup.trigger == "push":
         print(
-            f"unit check: press DATA once on the gauges (waiting up to {timeout:g} s)", flush=True
+            f"frames check: press DATA once on the gauges (waiting up to {timeout:g} s)",
+            flush=True,
         )
-    result = gauges.capture(timeout)
-    unit = setup.resolved_unit
-    mismatch = unit_mismatch(result.readings, setup.channels, unit)
-    if not mismatch:
+    # One reading set: its frames show the decimals and any unit the gauges state.
+    problem = gauges.check_frames(
+        setup.resolved_unit,
+        setup.resolved_resolution,
+        readings=1,
+        timeout=timeout,
+        channels=setup.channels,
+    )
+    if not problem:
         return
     if resume:
-        advice = f"switch the gauges to {unit}, then resume again"
+        advice = "set the gauges to the session's unit and resolution, then resume again"
     else:
-        other = next(r.unit for ch, r in result.readings.items() if r.unit != unit)
+        inferred = gauges.infer_frames(setup.channels).values()
+        units = {i.known_unit for i in inferred}
+        steps = {i.step for i in inferred if i.step}
+        unit = next(iter(units)) if len(units) == 1 and None not in units else "U"
+        step = f"{next(iter(steps)):g}" if len(steps) == 1 else "R"
         advice = (
-            f"start it in their unit (--unit {other} with --resolution and --limit in {other}), "
-            f"or switch the gauges to {unit}"
+            f"start it in the gauges' unit and resolution (--unit {unit} --resolution {step}, "
+            f"with --limit in {unit}), or set the gauges to the session's"
         )
-    raise StationError(f"{mismatch}: {advice}; nothing was written")
-
-
-def _frames_carry_unit(protocol: Any) -> bool:
-    """True when the protocol's frames say their unit: a frame it encodes in each unit parses
-    back with that unit (a unit-less frame parses with none)."""
-    from station.procedures import UNITS
-
-    channel = protocol.channels[0]
-    for unit in UNITS:
-        parsed = protocol.parse(protocol.encode(channel, 0.0, 0.001, unit).rstrip(b"\r\n"))
-        if getattr(parsed, "unit", None) != unit:
-            return False
-    return True
+    raise StationError(f"{problem}: {advice}; nothing was written")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -769,6 +862,7 @@ def run(args: argparse.Namespace) -> int:
     from station.run import plan_steps
 
     _check_answerable(plan_steps(setup), setup.procedure, inputs, done)
+    every, enter = _pacing(setup.trigger, args.every)
 
     caught: list[int] = []
     previous = {}
@@ -785,7 +879,7 @@ def run(args: argparse.Namespace) -> int:
                 if r.state != "connected"
             )
             raise StationError(f"the gauges did not connect within {timeout:g} s ({problems})")
-        _check_units(gauges, setup, timeout, args.resume)
+        _check_frames(gauges, setup, timeout, args.resume)
         if caught:
             return 128 + caught[0]  # before any session exists: nothing to record
         printer = _Printer(setup.resolved_resolution)
@@ -796,7 +890,16 @@ def run(args: argparse.Namespace) -> int:
             print(f"sessions folder: {folder} ({why})", flush=True)
             runner = Runner.start(setup, gauges, folder, listener=printer)
         print(f"session file: {runner.path}", flush=True)
-        headless = _Headless(runner, inputs, timeout, attempts, deadband=deadband, still=still)
+        headless = _Headless(
+            runner,
+            inputs,
+            timeout,
+            attempts,
+            deadband=deadband,
+            still=still,
+            every=every,
+            enter=enter,
+        )
         worker = threading.Thread(target=headless.run, name="station capture", daemon=True)
         worker.start()
         while not headless.done.wait(0.05):
@@ -891,6 +994,11 @@ def _print_summary(runner: Any, analysis: Any) -> None:
             f"Session file: {runner.path}",
             f"Last line hash (anchors the session file): {runner.last_hash}",
         ]
+        from station.text import zero_taken
+
+        zero = zero_taken([{"channels": runner.recorded_zero}], runner.setup.resolved_resolution)
+        if zero:
+            notes.append(zero)
         print(report.text(notes, alarms=True), end="")
     print(f"session file: {Path(runner.path)}")
     print(f"last hash: {runner.last_hash}")

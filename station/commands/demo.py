@@ -5,7 +5,10 @@ fixture for repeatability; two fixtures and a teach pendant for relative accurac
 bar with indicators h, v and a linear scale s for linearity), pre-fills the set-up with its port,
 and writes the demo's session files to a ``demo`` folder under the sessions folder (said on
 screen). Picking another procedure in the set-up starts that procedure's simulator. All are
-seeded and deterministic. ``--autopilot`` walks the procedure by itself (confirming the steps,
+seeded and deterministic. The repeatability robot moves: it leaves the fixture and comes back
+every ``--cycle-period`` seconds (2 by default) and the station takes a cycle each time it is
+back and still (the ``arrival`` trigger), as at a robot running its playback loop.
+``--autopilot`` walks the procedure by itself (confirming the steps,
 typing the pendant's coordinates, capturing every cycle or streaming every stroke at a watchable
 pace, rejecting one cycle with a reason) and stops on the summary.
 """
@@ -14,6 +17,9 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+
+DEMO_CYCLE_PERIOD = 2.0
+"""Seconds per round trip of the demo's repeatability robot: the rhythm of a playback loop."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -50,6 +56,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--seed", type=int, default=1990, help="simulator seed (default: %(default)s)"
     )
     parser.add_argument(
+        "--cycle-period",
+        type=float,
+        default=DEMO_CYCLE_PERIOD,
+        metavar="SECONDS",
+        help="repeatability: the simulated robot leaves the fixture and comes back every so "
+        "many seconds, and each return is a cycle (default: %(default)s)",
+    )
+    parser.add_argument(
         "--pace",
         type=float,
         default=0.2,
@@ -74,7 +88,9 @@ def run(args: argparse.Namespace) -> int:
         raise StationError(f"--count must be 1 or more, not {args.count}")
     _check_demo_choice(args)
     folder, reason = sessions_folder(args.sessions)
-    lab = DemoLab(args.seed)
+    if not args.cycle_period > 0:
+        raise StationError(f"--cycle-period must be more than 0 seconds, not {args.cycle_period}")
+    lab = DemoLab(args.seed, cycle_period=args.cycle_period)
     try:
         fixture = lab.fixture(args.procedure)
         config = StationConfig(

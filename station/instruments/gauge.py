@@ -604,6 +604,7 @@ class GaugeSet:
         # cancelling its subscription (nobody swaps another's callback).
         self._set_listeners: list[Callable[[CaptureResult], object]] = []
         self._status_listeners: list[Callable[[PortStatus], object]] = []
+        self._arrival_listeners: list[Callable[[ArrivalEvent], object]] = []
         self.stable_k = stable_k
         self.stable_ms = stable_ms
         self.poll_interval = poll_interval
@@ -723,14 +724,18 @@ class GaugeSet:
         *,
         on_set: Callable[[CaptureResult], object] | None = None,
         on_status: Callable[[PortStatus], object] | None = None,
+        on_arrival: Callable[[ArrivalEvent], object] | None = None,
     ) -> Subscription:
-        """Hear of every completed push set and every port change (on reader threads) until the
-        returned subscription is cancelled."""
+        """Hear of every completed push or arrival set, every port change and (``on_arrival``)
+        the arrival trigger's other events (departed, returned, unsettled), on reader threads,
+        until the returned subscription is cancelled."""
         with self._changed:
             if on_set is not None:
                 self._set_listeners.append(on_set)
             if on_status is not None:
                 self._status_listeners.append(on_status)
+            if on_arrival is not None:
+                self._arrival_listeners.append(on_arrival)
 
         def cancel() -> None:
             with self._changed:
@@ -738,14 +743,20 @@ class GaugeSet:
                     self._set_listeners.remove(on_set)
                 if on_status is not None and on_status in self._status_listeners:
                     self._status_listeners.remove(on_status)
+                if on_arrival is not None and on_arrival in self._arrival_listeners:
+                    self._arrival_listeners.remove(on_arrival)
 
         return Subscription(cancel)
 
     @property
     def listeners(self) -> int:
-        """How many set and status listeners are subscribed now."""
+        """How many set, status and arrival listeners are subscribed now."""
         with self._changed:
-            return len(self._set_listeners) + len(self._status_listeners)
+            return (
+                len(self._set_listeners)
+                + len(self._status_listeners)
+                + len(self._arrival_listeners)
+            )
 
     def _on_status(self, status: PortStatus) -> None:
         for listener in (self.on_status, *self._status_listeners):
@@ -797,13 +808,19 @@ class GaugeSet:
         return None
 
     def _deliver_arrival(self, events: list[ArrivalEvent]) -> None:
-        """Hand the detector's events other than a set to ``on_arrival`` (no lock held)."""
+        """Hand the detector's events other than a set to ``on_arrival`` and the subscribers
+        (no lock held)."""
+        if not events:
+            return
+        with self._changed:
+            listeners = (self.on_arrival, *self._arrival_listeners)
         for event in events:
             if event.kind == "settled":
                 continue
-            error = _call_quietly(self.on_arrival, event)
-            if error is not None:
-                self.readers[0].report(f"arrival callback failed: {error!r}")
+            for listener in listeners:
+                error = _call_quietly(listener, event)
+                if error is not None:
+                    self.readers[0].report(f"arrival callback failed: {error!r}")
 
     def _add_to_push_set(self, reading: GaugeReading) -> CaptureResult | None:
         if not self._pending and len(self.readers) == 1 and reading.channel != self.channels[0]:
@@ -1286,7 +1303,20 @@ class GaugeSet:
         every kept frame. A channel that sent nothing says nothing.
         """
         wanted = list(self.channels if channels is None else channels)
-        self.collect(wanted, readings, 0.0, timeout)
+        if self.trigger in ("poll", "stable") and all(
+            self._reader_of[c].protocol.polled for c in wanted
+        ):
+            # One request per reading, each answered before the next: the gauges are asked
+            # exactly ``readings`` times (a device, or a simulated robot, that counts its
+            # readings sees a known number).
+            deadline = time.monotonic() + timeout
+            for _ in range(readings):
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    break
+                self._capture_poll(remaining)
+        else:
+            self.collect(wanted, readings, 0.0, timeout)
         samples = self.frame_samples(wanted)
         inferred = {
             c: infer_channel(c, samples[c], self._reader_of[c].protocol.units_by_decimals)

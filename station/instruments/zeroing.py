@@ -133,8 +133,19 @@ def zero_from_readings(
             ChannelZero(channel, method, offset, len(values), mean, spread, tuple(values), res)
         )
     if moving:
-        raise StationError(moving_message(moving, still, window, unit))
+        raise GaugesMoving(
+            moving_message(moving, still, window, unit), tuple(c for c, _, _ in moving)
+        )
     return tuple(zeros)
+
+
+class GaugesMoving(StationError):
+    """A zero refused because channels move (``channels``): nothing was zeroed; wait for the
+    robot to be still and zero again."""
+
+    def __init__(self, message: str, channels: tuple[str, ...]) -> None:
+        super().__init__(message)
+        self.channels = channels
 
 
 def moving_message(
@@ -156,6 +167,7 @@ def moving_message(
 
 __all__ = [
     "ChannelZero",
+    "GaugesMoving",
     "DEFAULT_ZERO_READINGS",
     "DEFAULT_ZERO_SETTLE",
     "DEFAULT_ZERO_STILL",

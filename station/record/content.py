@@ -20,7 +20,13 @@ from typing import Any
 from station.analysis.report import decimals_for as report_decimals
 from station.analysis.rules import rule_name
 from station.record.source import AnalysedSession
-from station.text import NOT_AVAILABLE, format_value, judged_cpk, judged_label
+from station.text import (
+    NOT_AVAILABLE,
+    format_spread,
+    format_value,
+    judged_cpk,
+    judged_label,
+)
 
 MISSING = NOT_AVAILABLE
 """What an absent or undefined figure shows (the same ``-`` as every screen and command)."""
@@ -47,6 +53,8 @@ class ZeroLine:
     channel: str
     method: str
     offset: str
+    detail: str = ""
+    """`` (mean of 5 readings, spread 0.00010)`` for a zero from several readings, else ''."""
 
 
 @dataclass(frozen=True)
@@ -315,6 +323,14 @@ def _limits(header: Mapping[str, Any], resolution: float | None) -> tuple[LimitL
     return tuple(lines)
 
 
+def _zero_detail(spec: Mapping[str, Any], resolution: float | None) -> str:
+    """How a zero from several readings was taken: `` (mean of 5 readings, spread 0.00010)``."""
+    n, spread = spec.get("n"), spec.get("spread")
+    if not isinstance(n, int) or n < 2 or not isinstance(spread, int | float):
+        return ""
+    return f" (mean of {n} readings, spread {format_spread(float(spread), resolution)})"
+
+
 def _zeroes(session: Any, resolution: float | None) -> tuple[ZeroLine, ...]:
     lines = []
     for event in session.zeroes:
@@ -333,6 +349,7 @@ def _zeroes(session: Any, resolution: float | None) -> tuple[ZeroLine, ...]:
                     channel=str(channel),
                     method=str(spec.get("method") or MISSING),
                     offset=_reading(offset, resolution),
+                    detail=_zero_detail(spec, resolution),
                 )
             )
     return tuple(lines)

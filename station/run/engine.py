@@ -34,6 +34,12 @@ line while the disk syncs). A pushed set becomes a cycle while the step that was
 it arrived still is and takes sets. A capture, zero or stroke records only into the step it
 was started in.
 
+With the ``arrival`` trigger the engine also hears the robot's going and coming (said as
+information; a return that did not settle as a warning, never recorded), and arms the gauges
+each time a step that takes sets becomes current (its handler's ``entered``): a round trip under
+way before that step is not one of its cycles. A ``zero`` event updates the zero uncertainty
+the analysis weighs an offset from nominal against.
+
 A resumed session puts the recorded zero back on the gauges (each channel's last ``zero``
 event). A failed write (a full disk) makes the engine ``failed``; every later action raises the
 journal's own sentence (:attr:`Runner.failure`).
@@ -45,6 +51,7 @@ import contextlib
 import math
 import queue
 import threading
+import time
 from collections import deque
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
@@ -106,9 +113,21 @@ class Gauges(Protocol):
     readers: Sequence[Any]
 
     def capture(self, timeout: float = 2.0) -> CaptureResult: ...
-    def zero(self, channels: list[str], timeout: float, *, unit: str) -> Any: ...
+    def zero(
+        self,
+        channels: list[str],
+        timeout: float,
+        *,
+        unit: str,
+        readings: int = 1,
+        settle: float = 0.0,
+        still: float = 3.0,
+    ) -> Any: ...
     def set_zero_offsets(self, offsets: Mapping[str, float]) -> None: ...
-    def subscribe(self, *, on_set: Any = None, on_status: Any = None) -> Subscription: ...
+    def subscribe(
+        self, *, on_set: Any = None, on_status: Any = None, on_arrival: Any = None
+    ) -> Subscription: ...
+    def arm(self, timeout: float = 1.0) -> list[str]: ...
 
 
 class Journal(Protocol):
@@ -181,6 +200,8 @@ class Runner:
         self._alarm_flagged: dict[tuple[str, str], set[int]] = {}
         self._alarm_list: tuple[RecordedAlarm, ...] = ()
         self._port_states: dict[str, str] = {}
+        self._arm_pending = False
+        self._armed_at = float("-inf")
         self.header: Mapping[str, Any] = writer.snapshot().header
         self.config = analysis_config(self.header)
         self.kind = verdicts.kind_of(setup.procedure.analysis)
@@ -293,6 +314,7 @@ class Runner:
                 )
             self._next_cycle = session.next_cycle
             self._alarm_list = recorded_alarms(session)
+            self._zero_config()
             self._rebuild_live(session)
             self._views = ()
 
@@ -329,12 +351,14 @@ class Runner:
             self._subscription = self.gauges.subscribe(
                 on_set=self._on_set if self.gauges.trigger in DEVICE_DRIVEN_TRIGGERS else None,
                 on_status=self._on_port_status,
+                on_arrival=self._on_arrival if self.gauges.trigger == "arrival" else None,
             )
             with self.lock:
                 # The file says how each line stood when the session (re)started; changes
                 # follow.
                 for url, state in self._port_states.items():
                     self.append("instrument", port=url, state=state, message=moment)
+                self._step_entered()
         except BaseException:
             with self.lock:
                 self._close()
@@ -359,6 +383,40 @@ class Runner:
             level: MessageLevel = "info" if status.state == "connected" else "warning"
             self.say(level, f"{status.port}: {status.state} ({status.message})")
 
+    def _on_arrival(self, event: Any) -> None:
+        """The arrival trigger's news (departed, returned, unsettled), on a reader's thread:
+        handed to the intake thread, which says it (reported, never recorded)."""
+        if self._intake is not None:
+            self._intake.put(("arrival", event))
+
+    def _say_arrival(self, event: Any) -> None:
+        """Say an arrival event: the robot's going and coming as information, a return that
+        did not settle as a warning (no set was taken for it). Lock held."""
+        if self.status not in ("running", "paused"):
+            return
+        if event.kind == "departed":
+            self.say("info", f"The robot left the fixture ({', '.join(event.channels)} away).")
+        elif event.kind == "returned":
+            self.say("info", "The robot returned to the fixture; waiting for it to be still.")
+        elif event.kind == "unsettled":
+            self.say("warning", event.message)
+
+    def arm_trigger(self) -> None:
+        """A step that takes sets became current: with the ``arrival`` trigger, only a
+        departure from now on starts a cycle (a robot already on its way back when the step
+        began is not one). The gauges are armed on the intake thread, without the lock; sets
+        that arrived before are not recorded. Lock held."""
+        if self.setup.trigger != "arrival" or self._intake is None:
+            return
+        self._arm_pending = True
+        self._intake.put(("arm",))
+
+    def _step_entered(self) -> None:
+        """Tell the current step's handler that it became current. Lock held."""
+        item = self._item_or_none()
+        if item is not None and self.status == "running":
+            handler_for(item.step.kind).entered(self, item)
+
     def _on_set(self, result: CaptureResult) -> None:
         """A completed set the devices sent (push, arrival), on the reader's thread: note which
         step was current and hand it over, without the engine's lock."""
@@ -380,6 +438,14 @@ class Runner:
             queued = intake.get()
             if queued is None:
                 return
+            if queued[0] == "arm":
+                # Waits on the reader threads (a flush): never under the engine's lock.
+                with contextlib.suppress(StationError):
+                    self.gauges.arm(1.0)
+                with self.lock:
+                    self._armed_at = time.monotonic()
+                    self._arm_pending = False
+                continue
             with self.lock:
                 if self._writer.closed:
                     continue  # closed while this waited: the file takes nothing more
@@ -387,6 +453,8 @@ class Runner:
                 with contextlib.suppress(StationError):
                     if queued[0] == "status":
                         self._record_port_status(queued[1])
+                    elif queued[0] == "arrival":
+                        self._say_arrival(queued[1])
                     else:
                         self._record_pushed_set(*queued[1:])
 
@@ -396,6 +464,8 @@ class Runner:
             # A software zero took this set, the session is not running, or the step moved on
             # since the set arrived.
             return
+        if result.trigger == "arrival" and (self._arm_pending or result.t_trigger < self._armed_at):
+            return  # the robot came back before this step was armed: not one of its cycles
         item = self._item_or_none()
         if item is None or not handler_for(item.step.kind).takes_sets:
             # Said once per step: a streaming device sends many sets a second, which is
@@ -668,6 +738,8 @@ class Runner:
                 alarms=self._alarm_count,
                 alarm_list=self._alarm_list,
                 failure=self._failure or "",
+                next_cycle=self._next_cycle,
+                zero={channel: dict(zeroed) for channel, zeroed in self.recorded_zero.items()},
             )
 
     def prompt(self) -> str:
@@ -689,6 +761,16 @@ class Runner:
     def step_state(self, item: PlanItem) -> dict[str, Any]:
         """A plan item's own mutable state (a handler's counters), kept for the session."""
         return self._step_states.setdefault(item.key, {})
+
+    @property
+    def devices_pace(self) -> bool:
+        """True when the devices decide when a set is taken (push, arrival)."""
+        return self.setup.trigger in DEVICE_DRIVEN_TRIGGERS
+
+    @property
+    def next_cycle(self) -> int:
+        """The number the next recorded cycle gets."""
+        return self._next_cycle
 
     def accepted_in(self, item: PlanItem) -> int:
         """Accepted cycles recorded in a plan item."""
@@ -731,6 +813,7 @@ class Runner:
             by=by,
         )
         self._position += 1
+        self._step_entered()
         self._notify(None)
 
     def take_set(self, timeout: float, by: str) -> CycleOutcome:
@@ -743,7 +826,7 @@ class Runner:
                 if not self._outcome_ready.wait_for(
                     lambda: self._outcomes != seen or self.status != "running", timeout
                 ):
-                    return self.refuse(
+                    outcome = self.refuse(
                         f"No reading set arrived within {timeout:g} s: "
                         + (
                             "press DATA on the gauges (or check the cable)."
@@ -751,6 +834,7 @@ class Runner:
                             else "run the robot's playback (or check the cable)."
                         )
                     )
+                    return replace(outcome, waited=True)
                 if self.status == "failed":
                     self.ensure_open()  # raises the failure's own sentence
                 if self.status != "running" or self._last_outcome is None:
@@ -900,6 +984,23 @@ class Runner:
             self._accepted_by_step[key] = self._accepted_by_step.get(key, 0) + 1
         self._accepted_count = len(accepted)
         self._live = self._live.rebuilt([(r.values, r.cycle, r.times) for r in accepted], session)
+
+    def zero_recorded(self, event: Mapping[str, Any]) -> None:
+        """A ``zero`` event is on disk: the zero in force changed, and with it what the
+        analysis takes as the zero's own uncertainty (the live analysis is rebuilt on it, so it
+        stays equal to the batch analysis of the file). Lock held."""
+        for channel, zeroed in dict(event.get("channels") or {}).items():
+            self.recorded_zero[str(channel)] = dict(zeroed)
+        self._zero_config()
+        self._rebuild_live()
+
+    def _zero_config(self) -> None:
+        """The analysis config with the recorded zeros' uncertainties; a new live analysis on
+        it (the caller rebuilds it from the cycles)."""
+        config = analysis_config(self.header, [{"channels": self.recorded_zero}])
+        if config.zero_uncertainty != self.config.zero_uncertainty:
+            self.config = config
+            self._live = self.kind.live(self.config, self.setup.channels, self.header)
 
     def _item_or_none(self) -> PlanItem | None:
         return self._plan[self._position] if self._position < len(self._plan) else None

@@ -166,6 +166,17 @@ class SessionSetup:
         """Spec limits per channel: the procedure's defaults overridden by the set-up's."""
         return procedure_limits(self.procedure) | dict(self.limits or {})
 
+    def arrival_header(self) -> dict[str, Any]:
+        """The arrival trigger's parameters as the session header records them (the band in
+        the session's unit, resolved from the resolution when the procedure gives none)."""
+        arrival = self.procedure.arrival
+        return {
+            "band": arrival.band_of(self.resolved_resolution),
+            "still": arrival.still,
+            "settle": arrival.settle,
+            "timeout": arrival.timeout,
+        }
+
     def header_fields(self) -> dict[str, Any]:
         """The session header's fields (the journal adds format, session id, created, prev).
         Each step kind in the plan may add fields of its own (a stroke step records the
@@ -190,6 +201,7 @@ class SessionSetup:
             "instruments": {
                 "trigger": self.trigger,
                 "ports": [port.header() for port in self.ports],
+                **({"arrival": self.arrival_header()} if self.trigger == "arrival" else {}),
             },
             "cycles_target": self.resolved_cycles,
             # The count below which a verdict is provisional, and when the live limits freeze.
@@ -269,13 +281,21 @@ def open_gauges(
     *,
     backoff: tuple[float, float] | None = None,
     on_reading: Callable[[Any], object] | None = None,
-    poll_interval: float = 0.1,
+    poll_interval: float | None = None,
 ) -> GaugeSet:
     """Build and start the :class:`~station.instruments.gauge.GaugeSet` the set-up describes.
 
-    The engine subscribes to its sets and port changes; ``on_reading`` (every accepted frame,
-    on a reader thread) is for a live display. The caller stops the set when done.
+    The engine subscribes to its sets, port changes and arrival news; ``on_reading`` (every
+    accepted frame, on a reader thread) is for a live display. The caller stops the set when
+    done. The ``arrival`` trigger takes the procedure's ``[arrival]`` table (its band, by
+    default 100 resolutions of the session's gauges); ``poll_interval`` (how often a polled
+    device is asked while the gauges are read continuously) is by default 0.1 s, or a quarter
+    of the arrival settle time when that is shorter, so stillness is judged on several
+    readings.
     """
+    arrival = setup.procedure.arrival
+    if poll_interval is None:
+        poll_interval = min(0.1, arrival.settle / 4) if setup.trigger == "arrival" else 0.1
     specs = [
         PortSpec(
             url=port.url,
@@ -293,6 +313,7 @@ def open_gauges(
         poll_interval=poll_interval,
         on_reading=on_reading,
         backoff=backoff or DEFAULT_BACKOFF,
+        arrival=arrival,
     )
     gauges.start()
     return gauges

@@ -49,6 +49,9 @@ class Action:
     prompt: str = ""
     fields: tuple[InputField, ...] = ()
     may_confirm: bool = False
+    paced_by_devices: bool = False
+    """For ``capture``: the sets come by themselves (the robot's arrival, a DATA press), so a
+    front end says so instead of asking for a key per cycle."""
 
     def __post_init__(self) -> None:
         if self.kind not in ACTION_KINDS:
@@ -159,6 +162,9 @@ class CycleOutcome:
     port_down: bool = False
     """Refused only because a port was down for the whole wait (the line is reconnecting):
     not the gauges refusing a set, so a caller counting refusals should not count it."""
+    waited: bool = False
+    """Nothing arrived within the wait while the devices set the pace (push, arrival): the
+    operator or the robot has not given a set yet, which is not a refused set."""
 
 
 @dataclass(frozen=True)
@@ -215,6 +221,12 @@ class RunnerState:
     failure: str = ""
     """Why the session failed (status ``failed``: a write failed, e.g. the disk is full);
     empty otherwise."""
+    zero: Mapping[str, Any] = field(default_factory=dict)
+    """The zero in force per channel: its last ``zero`` event's entry (method, offset, n,
+    mean, spread...)."""
+    next_cycle: int = 1
+    """The number the next recorded cycle gets (numbering runs over the whole session and
+    skips nothing: a rejected cycle keeps its number)."""
 
     @property
     def accepted(self) -> int:

@@ -8,7 +8,7 @@ configuration (the session package never reaches up into the engine for it).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -33,9 +33,26 @@ def header_limits(header: Mapping[str, Any]) -> dict[str, SpecLimits]:
     }
 
 
-def analysis_config(header: Mapping[str, Any]) -> AnalysisConfig:
+def zero_uncertainties(zeroes: Iterable[Mapping[str, Any]]) -> dict[str, float]:
+    """Each channel's zero uncertainty from a session's ``zero`` events (the last one of a
+    channel is the zero in force; an old event without ``uncertainty`` says nothing)."""
+    found: dict[str, float] = {}
+    for event in zeroes:
+        for channel, spec in dict(event.get("channels") or {}).items():
+            value = spec.get("uncertainty") if isinstance(spec, Mapping) else None
+            if isinstance(value, int | float) and not isinstance(value, bool) and value >= 0:
+                found[str(channel)] = float(value)
+            else:
+                found.pop(str(channel), None)
+    return found
+
+
+def analysis_config(
+    header: Mapping[str, Any], zeroes: Iterable[Mapping[str, Any]] = ()
+) -> AnalysisConfig:
     """The :class:`AnalysisConfig` a session header implies: its limits, resolution, unit, rule
-    set and threshold (single readings, subgroup 1)."""
+    set and threshold (single readings, subgroup 1); ``zeroes`` (the session's ``zero``
+    events) give each channel's zero uncertainty."""
     resolution = header.get("resolution")
     minimum, freeze = header.get("cycles_min"), header.get("freeze_after")
     return AnalysisConfig(
@@ -47,6 +64,7 @@ def analysis_config(header: Mapping[str, Any]) -> AnalysisConfig:
         min_n=minimum if isinstance(minimum, int) and minimum >= 0 else DEFAULT_MIN_N,
         freeze_after=freeze if isinstance(freeze, int) and freeze >= 2 else DEFAULT_FREEZE_AFTER,
         baseline=baseline_from_json(header.get("baseline")),
+        zero_uncertainty=zero_uncertainties(zeroes),
     )
 
 

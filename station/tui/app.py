@@ -46,6 +46,8 @@ HANGUP_EXIT_CODES = {signal.SIGHUP: 129, signal.SIGTERM: 143}
 
 PORT_OPEN_TIMEOUT = 3.0
 """Seconds the set-up waits for the gauges' port to open before it refuses to start."""
+FRAMES_TIMEOUT = 2.0
+"""Seconds the set-up reads frames for, to check the gauges' unit and resolution."""
 
 
 class PortNotOpen(StationError):
@@ -256,6 +258,21 @@ class StationApp(App[int]):
             raise PortNotOpen(
                 f"the port did not open within {PORT_OPEN_TIMEOUT:g} s ({'; '.join(down)}); "
                 "correct it and press F2 again (F3 tests the line)"
+            )
+        # What the gauges send must be what the session says, before any file exists.
+        problem = self.gauges.check_frames(
+            setup.resolved_unit,
+            setup.resolved_resolution,
+            readings=1,  # one reading set: its frames show the decimals and a stated unit
+            timeout=FRAMES_TIMEOUT,
+            channels=setup.channels,
+        )
+        if problem:
+            self.close_instruments()
+            raise StationError(
+                f"{problem[0].upper()}{problem[1:]}: set the unit and resolution to the "
+                "gauges' (or the gauges to the session's); nothing was written",
+                field="unit",
             )
 
     def resume_session(self, path: Path, ports: Any) -> None:

@@ -66,6 +66,7 @@ def start_demo_fixture(
     resolution: float = 0.0001,
     link: str | None = None,
     stroke_points: int = 400,
+    cycle_period: float | None = None,
 ) -> DemoFixture:
     """Start the simulator of ``procedure``'s set-up on a pseudo-terminal, seeded.
 
@@ -78,7 +79,12 @@ def start_demo_fixture(
       pushing ``BAR_PUSH_RATE`` sets a second; ``stroke_points`` points per stroke.
 
     ``link``: a fixed path for the pty (a symlink), instead of ``/dev/pts/N``.
+    ``cycle_period``: the repeatability robot leaves the fixture and comes back every so many
+    seconds (its indicators at free travel while away, a short overshoot on return), and the
+    set-up takes the ``arrival`` trigger: the station counts the robot's round trips. Without
+    it every poll is a new rest position (Space per cycle).
     """
+    from station.instruments.motion import CycleMotion, default_free_travel
     from station.instruments.protocols import get_protocol
     from station.instruments.simulator import (
         AxisModel,
@@ -111,7 +117,14 @@ def start_demo_fixture(
             gauge,
         )
         description = "simulated dial indicators (seeded)"
-    simulator = Simulator(protocol, model, seed=seed, channel_map=channel_map, push_rate=push_rate)
+    motion = None
+    if cycle_period is not None and isinstance(model, FixtureModel):
+        motion = CycleMotion(cycle_period, default_free_travel(unit), 20 * resolution)
+        trigger = "arrival"
+        description = f"simulated dial indicators, the robot back every {cycle_period:g} s (seeded)"
+    simulator = Simulator(
+        protocol, model, seed=seed, channel_map=channel_map, push_rate=push_rate, motion=motion
+    )
     url = simulator.start_pty(link=link)
     return DemoFixture(
         url=url,
@@ -128,9 +141,13 @@ class DemoLab:
     """The demo's simulators, one per procedure, each started the first time it is asked for
     (so the set-up's procedure picker switches the simulated set-up with the procedure)."""
 
-    def __init__(self, seed: int = 1990, *, stroke_points: int = 400) -> None:
+    def __init__(
+        self, seed: int = 1990, *, stroke_points: int = 400, cycle_period: float | None = None
+    ) -> None:
         self.seed = seed
         self.stroke_points = stroke_points
+        self.cycle_period = cycle_period
+        """The repeatability robot's round trip in seconds (None: it does not move)."""
         self._fixtures: dict[str, DemoFixture] = {}
 
     def fixture(self, procedure: str) -> DemoFixture:
@@ -138,7 +155,10 @@ class DemoLab:
         key = procedure if procedure in DEMO_PROCEDURES else "repeatability"
         if key not in self._fixtures:
             self._fixtures[key] = start_demo_fixture(
-                self.seed, procedure=key, stroke_points=self.stroke_points
+                self.seed,
+                procedure=key,
+                stroke_points=self.stroke_points,
+                cycle_period=self.cycle_period,
             )
         return self._fixtures[key]
 
@@ -171,13 +191,24 @@ def gauge_set(ports: Sequence[Any], trigger: str, **options: Any) -> Any:
 
 
 def test_connection(
-    ports: Sequence[Any], trigger: str, captures: int = TEST_CAPTURES, timeout: float = 3.0
+    ports: Sequence[Any],
+    trigger: str,
+    captures: int = TEST_CAPTURES,
+    timeout: float = 3.0,
+    *,
+    unit: str | None = None,
+    resolution: float | None = None,
 ) -> Iterator[list[str]]:
-    """Open the line, take a few reading sets and yield the lines to show after each one.
+    """Open the line, take a few reading sets and yield the lines to show after each one;
+    with ``unit`` and ``resolution``, then judge the frames against them.
 
-    Nothing is recorded. Raises StationError when the port cannot be opened or stays silent.
+    Nothing is recorded. Raises StationError when the port cannot be opened or stays silent,
+    or when the frames disagree with the unit and resolution (naming both).
     """
-    gauges = gauge_set(ports, trigger if trigger != "push" else "poll")
+    from station.instruments.units import describe_inference
+
+    # Arrival waits for the robot: the test polls (a push device is polled too, where it can).
+    gauges = gauge_set(ports, "poll" if trigger in ("push", "arrival") else trigger)
     gauges.start()
     try:
         if not gauges.wait_connected(timeout):
@@ -196,6 +227,16 @@ def test_connection(
             note = f"  ({result.message})" if result.message else ""
             lines = [*lines, f"  {number}: {values or 'no reading'}{note}"]
             yield lines
+        if unit is not None and resolution is not None:
+            # The frames of the sets just shown (no more readings are taken).
+            problem = gauges.check_frames(unit, resolution, readings=0, timeout=timeout)
+            if problem:
+                raise StationError(
+                    f"The line works, but {problem}: set the unit and resolution to the "
+                    "gauges' (or the gauges to the session's) before starting"
+                )
+            inferred = describe_inference(gauges.infer_frames())
+            lines = [*lines, f"The frames agree with {unit} at {resolution:g} ({inferred})."]
         yield [*lines, "The line works. Press F2 to start."]
     finally:
         gauges.stop()

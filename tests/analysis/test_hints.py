@@ -66,3 +66,20 @@ def test_a_tolerance_under_ten_gauge_steps_means_the_gauge_is_too_coarse():
     (hint,) = [h for h in hints(noise(), default_limits=narrow) if "too coarse" in h]
     assert "8 gauge steps" in hint and hint.startswith("x:")
     assert not [h for h in hints(noise()) if "too coarse" in h]
+
+
+def test_an_offset_the_zero_explains_is_said_to_be_the_zeros():
+    # Every reading carries the zero taken: +0.0002 off nominal with a zero known to ±0.0003
+    # (2u) is no evidence against the robot (the one-reading zero of -0.0010).
+    values = noise() + 0.0002
+    (hint,) = [h for h in hints(values, zero_uncertainty={"x": 0.00015}) if "off nominal" in h]
+    assert "within what the zero's own uncertainty (±0.0003 in) explains" in hint
+    assert "zero again from more readings" in hint
+    assert "inverse kinematics" not in hint
+
+
+def test_an_offset_beyond_the_zeros_uncertainty_still_points_at_the_robot():
+    values = noise() + 0.0004
+    (hint,) = [h for h in hints(values, zero_uncertainty={"x": 0.00003}) if "off nominal" in h]
+    assert "beyond the zero's own uncertainty (±6e-05 in)" in hint
+    assert "inverse kinematics" in hint

@@ -89,7 +89,11 @@ def _station(*args: str) -> list[str]:
 
 def test_autopilot_demo_reaches_the_verdict(tmp_path: Path) -> None:
     pane = Pane(
-        _station("demo", "--autopilot", "--pace", "0.05", "--sessions", str(tmp_path)), tmp_path
+        # The demo's robot comes back every 2 s (the arrival trigger counts its round trips).
+        _station(
+            "demo", "--autopilot", "--count", "5", "--pace", "0.05", "--sessions", str(tmp_path)
+        ),
+        tmp_path,
     )
     try:
         pane.wait_for("Verdict:", timeout=90)

@@ -251,7 +251,19 @@ def test_report_of_a_real_headless_capture(tmp_path):
     station = [sys.executable, "-m", "station"]
     environment = {**os.environ, "STATION_PROCEDURES": ""}
     simulate = subprocess.Popen(
-        [*station, "simulate", "--protocol", "mitutoyo", "--unit", "in", "--seed", "3"],
+        # Inch gauges at the procedure's 0.0001 (the frames are checked against the session).
+        [
+            *station,
+            "simulate",
+            "--protocol",
+            "mitutoyo",
+            "--unit",
+            "in",
+            "--resolution",
+            "0.0001",
+            "--seed",
+            "3",
+        ],  # fmt: skip
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -265,6 +277,7 @@ def test_report_of_a_real_headless_capture(tmp_path):
                 *station, "capture", "--procedure", "repeatability", "--port", url,
                 "--protocol", "mitutoyo", "--robot", "R1", "--operator", "ana",
                 "--sessions", str(tmp_path / "sessions"), "--cycles", "25",
+                "--trigger", "poll", "--every", "0.01",
             ],
             capture_output=True, text=True, env=environment, timeout=120,
         )  # fmt: skip

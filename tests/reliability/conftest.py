@@ -145,6 +145,8 @@ def capture_args(
         f"{timeout:g}",
         "--trigger",
         trigger,
+        # Polled cycles are paced: a short --every (the simulator does not move).
+        *(["--every", "0.01"] if trigger == "poll" else []),
     ]
 
 

@@ -49,7 +49,7 @@ def test_file_size_limit_stops_with_one_line(simulators, tmp_path):
     path = assert_stopped_cleanly(capture, "file-size limit")
     assert path.stat().st_size <= FILE_LIMIT
 
-    resumed = Capture(["--resume", str(path), "--timeout", "3"])
+    resumed = Capture(["--resume", str(path), "--timeout", "3", "--every", "0.01"])
     assert resumed.finish(60) == 0, resumed.errors
     final = load_session(path)
     assert final.status == "finished" and len(final.accepted_cycles) == CYCLES
@@ -82,7 +82,7 @@ def test_full_disk_stops_with_one_line(simulators, small_tmpfs, tmp_path):
     # Free room the way an operator would (move the file to a roomy disk), then resume there.
     roomy = tmp_path / path.name
     shutil.copyfile(path, roomy)
-    resumed = Capture(["--resume", str(roomy), "--timeout", "3"])
+    resumed = Capture(["--resume", str(roomy), "--timeout", "3", "--every", "0.01"])
     assert resumed.finish(60) == 0, resumed.errors
     assert load_session(roomy).status == "finished"
 

@@ -105,7 +105,7 @@ def test_kill9_at_random_moments(simulators, tmp_path):
         path = run.capture.session_path
         before = load_session(path)
         assert before.status == "running"  # killed: no word from the writer
-        resumed = Capture(["--resume", str(path), "--timeout", "3"])
+        resumed = Capture(["--resume", str(path), "--timeout", "3", "--every", "0.01"])
         assert resumed.finish(60) == 0, resumed.errors
         after = load_session(path)
         assert after.status == "finished"
@@ -134,7 +134,7 @@ def test_kill9_resume_twice(simulators, tmp_path):
     path = first.session_path
     assert path is not None
     before_second = load_session(path)
-    second = Capture(["--resume", str(path), "--timeout", "3"])
+    second = Capture(["--resume", str(path), "--timeout", "3", "--every", "0.01"])
     assert second.wait_line(lambda line: line.startswith("cycle "), 30.0), second.errors
     second.process.send_signal(signal.SIGKILL)
     second.finish()
@@ -143,7 +143,7 @@ def test_kill9_resume_twice(simulators, tmp_path):
     assert_acknowledged_kept(second, session)
     assert min(second.acknowledged) == before_second.next_cycle
     assert verify_session(path).ok
-    third = Capture(["--resume", str(path), "--timeout", "3"])
+    third = Capture(["--resume", str(path), "--timeout", "3", "--every", "0.01"])
     assert third.finish(60) == 0, third.errors
     final = load_session(path)
     assert final.status == "finished" and len(final.accepted_cycles) == CYCLES

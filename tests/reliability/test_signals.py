@@ -14,10 +14,10 @@ from station.session.verify import verify_session
 from .conftest import Capture, assert_acknowledged_kept, capture_args
 
 CYCLES = 60
-HELD_AFTER = 10
-"""The simulator stops answering after this many readings of z (the unit check's, the zero's
-and a few cycles'): the capture cannot run out of cycles before the signal, however slow the
-machine."""
+HELD_AFTER = 30
+"""The simulator stops answering after this many readings of z (the frames check's few, the
+zero's and a few cycles'): the capture cannot run out of cycles before the signal, however
+slow the machine."""
 
 
 @pytest.mark.parametrize("signum", [signal.SIGHUP, signal.SIGTERM], ids=["SIGHUP", "SIGTERM"])
@@ -62,7 +62,7 @@ def test_signal_mid_capture_is_clean_and_resumable(simulators, tmp_path, signum)
     # After a hang-up the adapter may come back as another device: resume on a new port.
     moved = signum == signal.SIGHUP
     port = ["--port", simulators(99).url, "--protocol", "mitutoyo"] if moved else []
-    resumed = Capture(["--resume", str(path), "--timeout", "3", *port])
+    resumed = Capture(["--resume", str(path), "--timeout", "3", "--every", "0.01", *port])
     assert resumed.finish(60) == 0, resumed.errors
     assert min(resumed.acknowledged) == max(session.cycles) + 1
     final = load_session(path, recover=False)

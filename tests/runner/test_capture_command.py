@@ -47,7 +47,7 @@ def test_full_headless_session(simulator, procedures, tmp_path):
         "capture", "--procedure", "every-kind", "--procedures", str(procedures),
         "--port", simulator.url, "--protocol", "mitutoyo", "--robot", "KSC 7/../../etc",
         "--operator", "ana", "--sessions", str(sessions), "--input", "x=12.5",
-        "--limit", "x=-0.002:0.002", "--cycles", "4",
+        "--limit", "x=-0.002:0.002", "--cycles", "4", "--every", "0.01",
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
@@ -128,7 +128,7 @@ def test_refused_sets_stop_the_run_resumably(simulator, procedures, tmp_path, pr
         "capture", "--procedure", procedure, "--procedures", str(procedures),
         "--port", simulator.url, "--protocol", "mitutoyo", "--robot", "r",
         "--sessions", str(tmp_path / "s"), "--map", "1=x,2=y,4=z", "--timeout", "0.3",
-        "--attempts", "2",
+        "--attempts", "2", "--trigger", "poll", "--every", "0.01",
     )  # fmt: skip
     assert done.returncode == 2
     errors = [line for line in done.stderr.splitlines() if not line.startswith("station: warn")]
@@ -160,7 +160,7 @@ def test_unit_and_resolution_options(procedures, tmp_path):
             "capture", "--procedure", "cycles-only", "--procedures", str(procedures),
             "--port", sim.url, "--protocol", "mitutoyo", "--robot", "r", "--sessions",
             str(tmp_path), "--unit", "mm", "--resolution", "0.001", "--cycles", "3",
-            "--limit", "x=-0.05:0.05",
+            "--limit", "x=-0.05:0.05", "--every", "0.01",
         )  # fmt: skip
     finally:
         sim.stop()
@@ -189,7 +189,7 @@ def test_gauges_in_another_unit_are_refused_before_the_session(procedures, tmp_p
         sim.stop()
     assert done.returncode == 2, done.stdout + done.stderr
     assert done.stderr.count("\n") == 1, done.stderr
-    assert "x, y, z read in mm but the session is in in" in done.stderr
+    assert "the gauges send steps of 0.001 mm; the session is in inches at 0.0001" in done.stderr
     assert "--unit mm" in done.stderr and "nothing was written" in done.stderr
     assert not list(tmp_path.glob("*.jsonl"))
 
@@ -246,6 +246,7 @@ def test_resume_accepts_the_same_setup_again(tmp_path):
         "capture", "--resume", str(path), "--timeout", "0.3", "--procedure", "repeatability",
         "--robot", "KSC-7", "--operator", "ana", "--cycles", "28", "--trigger", "poll",
         "--unit", "in", "--resolution", "0.0001", "--limit", "x=-0.001:0.001",
+        "--every", "0.01",
     )  # fmt: skip
     # Past the option check: it fails only because the recorded port does not exist.
     assert done.returncode == 2 and "did not connect" in done.stderr, done.stderr
@@ -278,7 +279,7 @@ def test_a_crash_in_the_capture_thread_interrupts_the_session(simulator, tmp_pat
     done = subprocess.run(
         [sys.executable, "-c", CRASHING, "capture", "--procedure", "repeatability",
          "--port", simulator.url, "--protocol", "mitutoyo", "--robot", "r",
-         "--sessions", str(tmp_path), "--cycles", "30"],
+         "--sessions", str(tmp_path), "--cycles", "30", "--trigger", "poll", "--every", "0.01"],
         capture_output=True, text=True, cwd=REPO, timeout=60,
         env={**os.environ, "STATION_PROCEDURES": ""},
     )  # fmt: skip

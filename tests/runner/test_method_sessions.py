@@ -43,6 +43,8 @@ def capture(
         [
             *STATION,
             "capture",
+            "--every",
+            "0.01",
             "--procedure",
             procedure,
             "--port",

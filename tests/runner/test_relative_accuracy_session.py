@@ -149,6 +149,8 @@ def capture_args(url: str, folder: Path, inputs: Path) -> list[str]:
     return [
         *STATION,
         "capture",
+        "--every",
+        "0.01",
         "--procedure",
         "relative_accuracy",
         "--port",

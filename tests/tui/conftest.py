@@ -8,7 +8,7 @@ from collections.abc import Callable, Iterator
 from types import SimpleNamespace
 
 import pytest
-from textual.widgets import Input
+from textual.widgets import Input, Select
 
 from station.tui.instruments import DemoFixture, start_demo_fixture
 
@@ -45,6 +45,8 @@ async def open_setup(pilot, robot: str, port: str, operator: str = "operator-1")
     app.screen.query_one("#port", Input).value = port
     app.screen.query_one("#operator", Input).value = operator
     app.screen.query_one("#map", Input).value = "1=x,2=y,3=z"
+    # The static simulator shows a new rest position at every poll: Space paces its cycles.
+    app.screen.query_one("#trigger", Select).value = "poll"
 
 
 async def walk_checklist(pilot) -> int:

@@ -48,7 +48,7 @@ def test_headless_capture_runs_a_registered_step_and_analysis_kind(tmp_path, fix
     done = _station_with_kinds(
         "capture", "--procedure", "soak-check", "--procedures", str(folder),
         "--port", fixture_pty.url, "--protocol", fixture_pty.protocol, "--robot", "R1",
-        "--sessions", str(tmp_path / "sessions"), "--timeout", "5",
+        "--sessions", str(tmp_path / "sessions"), "--timeout", "5", "--every", "0.01",
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert "SPREAD REPORT" in done.stdout and "x range" in done.stdout

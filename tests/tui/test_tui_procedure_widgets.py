@@ -58,6 +58,8 @@ def test_the_count_field_follows_the_procedure() -> None:
     placements = count_field(catalog.get("relative_accuracy"))
     assert (placements.label, placements.setup_key) == ("Placements", "placements")
     cycles = count_field(catalog.get("repeatability"))
-    assert (cycles.label, cycles.setup_key, cycles.minimum) == ("Cycles", "cycles", 25)
+    # A short trial run is allowed (the verdict is provisional below the report's 25).
+    assert (cycles.label, cycles.setup_key, cycles.minimum) == ("Cycles", "cycles", 2)
+    assert "25 to 30" in cycles.hint
     # The linear scale measures the position along the bar: it takes no limits.
     assert judged_channels(linearity) == ["h", "v"]

@@ -61,6 +61,10 @@ class StepHandler:
         """Fields this step kind adds to the session header (e.g. a deadband)."""
         return {}
 
+    def entered(self, run: Runner, item: PlanItem) -> None:
+        """The step became current (the session started or resumed on it, or the step before
+        it was completed). Lock held."""
+
     # -- what the operator sees ---------------------------------------------------------------
 
     def action(self, run: Runner, item: PlanItem) -> Action:

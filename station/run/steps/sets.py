@@ -31,14 +31,24 @@ class SetStep(StepHandler):
         """(target, minimum) accepted sets."""
         return (1, 1)
 
+    def entered(self, run: Runner, item: PlanItem) -> None:
+        # With the arrival trigger, the robot's next round trip from now is the first cycle.
+        run.arm_trigger()
+
     def action(self, run: Runner, item: PlanItem) -> Action:
         target, minimum = self.counts(run, item)
         done = run.accepted_in(item)
+        paced = run.devices_pace
         if done >= target:
             # Still the capture family (the dashboard stays up), with nothing left to take.
             prompt = f"All {target} cycles are recorded: go on, or finish."
-            return Action("capture", prompt=prompt, may_confirm=True)
-        return Action("capture", prompt=self.prompt(run, item), may_confirm=done >= minimum)
+            return Action("capture", prompt=prompt, may_confirm=True, paced_by_devices=paced)
+        return Action(
+            "capture",
+            prompt=self.prompt(run, item),
+            may_confirm=done >= minimum,
+            paced_by_devices=paced,
+        )
 
     def capture(self, run: Runner, item: PlanItem, timeout: float, by: str) -> CycleOutcome:
         return run.take_set(timeout, by)
@@ -96,10 +106,20 @@ class CyclesStep(SetStep):
         return Progress(run.accepted_in(item), target, minimum, "cycle")
 
     def prompt(self, run: Runner, item: PlanItem) -> str:
+        """The step's per-cycle prompt. Outside a repeat block ``{cycle}`` is the number the
+        next cycle is recorded under; once a rejected cycle makes it differ from the count of
+        accepted ones, both are said: ``Cycle 5 (4 of 30 accepted)``."""
         if not item.step.prompt:
             return super().prompt(run, item)
         target, _ = self.counts(run, item)
-        return item.step.prompt_for(min(run.accepted_in(item) + 1, target), target)
+        ordinal = min(run.accepted_in(item) + 1, target)
+        number = run.next_cycle
+        if item.placement is not None or number == ordinal:
+            return item.step.prompt_for(ordinal, target)
+        # Numbers by the record: the prompt names the cycle the file and the reports will.
+        counted = f"{number} ({ordinal} of {target} accepted)"
+        text = item.step.prompt.replace("{cycle} of {count}", counted)
+        return text.replace("{cycle}", str(number)).replace("{count}", str(target))
 
     def confirm(self, run: Runner, item: PlanItem, by: str) -> None:
         if run.busy:

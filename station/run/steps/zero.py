@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from station.errors import StationError
+from station.instruments.zeroing import DEFAULT_ZERO_SETTLE, DEFAULT_ZERO_STILL
 from station.procedures import StepSchema
 from station.run.state import Action
 from station.run.steps import register
@@ -15,6 +16,8 @@ if TYPE_CHECKING:
     from station.run.engine import Runner
 
 ZERO_TIMEOUT = 5.0
+ARRIVAL_ZERO_READINGS = 5
+"""Readings per channel of a zero step without ``readings`` under the ``arrival`` trigger."""
 
 
 class ZeroStep(StepHandler):
@@ -31,14 +34,33 @@ class ZeroStep(StepHandler):
         # Confirming a zero step is zeroing: the engine releases its lock for the wait.
         run.zero(by=by)
 
+    @staticmethod
+    def default_readings(run: Runner) -> int:
+        """Readings per channel when the step does not say: with the ``arrival`` trigger the
+        robot is known to move between cycles, so the zero is a mean taken while every gauge
+        is still (a single reading could be taken mid-travel); otherwise one reading set (or
+        the gauge's own zero command), as before zero windows existed."""
+        return ARRIVAL_ZERO_READINGS if run.setup.trigger == "arrival" else 1
+
     def zero(self, run: Runner, item: PlanItem, by: str, timeout: float) -> None:
-        """A port that is down is waited for until ``timeout``; a gauge reading in another unit
-        than the session's is refused (nothing zeroed)."""
+        """The mean of the step's ``readings`` (when it gives them) per channel over its
+        ``settle`` seconds
+        (refused, naming the channel, while a channel's readings spread over more than ``still``
+        resolutions: the robot or a gauge moves). A port that is down is waited for until
+        ``timeout``; a gauge reading in another unit than the session's is refused (nothing
+        zeroed). The event records per channel the method, offset, n, mean, spread, readings
+        and the zero's standard uncertainty."""
+        step = item.step
         with run.lock:
             run.claim()
         try:
             results = run.gauges.zero(
-                list(item.step.channels), timeout, unit=run.setup.resolved_unit
+                list(step.channels),
+                timeout,
+                unit=run.setup.resolved_unit,
+                readings=step.readings or self.default_readings(run),
+                settle=step.settle if step.settle is not None else DEFAULT_ZERO_SETTLE,
+                still=step.still if step.still is not None else DEFAULT_ZERO_STILL,
             )
         except StationError as error:
             with run.lock:
@@ -52,16 +74,17 @@ class ZeroStep(StepHandler):
         with run.lock:
             run.release()
             run.ensure_open()
-            run.append(
+            event = run.append(
                 "zero",
                 step=item.step.id,
                 placement=item.placement,
                 channels={
-                    result.channel: {"method": result.method, "offset": result.offset}
+                    result.channel: {**result.record(), "uncertainty": result.uncertainty}
                     for result in results
                 },
                 by=by,
             )
+            run.zero_recorded(event)
             run.complete_step(item, by)
 
 

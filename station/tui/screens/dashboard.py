@@ -29,7 +29,7 @@ from station.tui.widgets.alarm_log import AlarmLog, alarm_lines, recorded_alarm_
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.figures import decimals_for
 from station.tui.widgets.histogram import HistogramView, histogram_data
-from station.tui.widgets.instrument_status import InstrumentStatus
+from station.tui.widgets.instrument_status import InstrumentStatus, status_text
 from station.tui.widgets.stats_panel import StatsPanel, StatsRows
 
 if TYPE_CHECKING:
@@ -62,6 +62,8 @@ class DashboardView:
     the log shows the chart's alarms instead (a file without alarm events)."""
     no_alarms: str = "alarms: none"
     """What the log says while there is no alarm (live: when the control limits freeze)."""
+    zero: str = ""
+    """The zero in force, one compact line (``zero x +0.0003 y -0.0001 (5 readings)``)."""
 
     @classmethod
     def from_live(
@@ -82,7 +84,11 @@ class DashboardView:
             progress = f"{counted.noun} {counted.done} of {counted.target}"
             if not counted.enough:
                 progress += f" (at least {counted.minimum})"
-            prompt = (state.action.prompt or current.step.title) + "  Press Space to capture."
+            prompt = (state.action.prompt or current.step.title) + (
+                "  The station captures each return of the robot."
+                if state.action.paced_by_devices
+                else "  Press Space to capture."
+            )
         elif state.action.kind == "capture":
             ready = False
             progress = f"{len(accepted)} captured"
@@ -98,6 +104,9 @@ class DashboardView:
             prompt = "Every cycle asked for is captured. Press f to finish and see the verdict."
         if rejected:
             progress += f", {rejected} rejected"
+        if last_cycle is not None and last_cycle.rejected is not None:
+            # The reading column shows no rejected value as if it were the last reading.
+            progress += f" (cycle {last_cycle.cycle} rejected)"
         if state.status == "paused":
             progress += "  PAUSED"
             prompt = "Captures are paused. Press p to continue."
@@ -108,7 +117,9 @@ class DashboardView:
             prompt=prompt,
             channels=channels,
             analyses=dict(analysis.channels) if analysis is not None else {},
-            last=dict(last_cycle.values) if last_cycle is not None else {},
+            last=dict(last_cycle.values)
+            if last_cycle is not None and last_cycle.rejected is None
+            else {},
             cycle_numbers=tuple(record.cycle for record in accepted),
             ports=tuple(state.instruments),
             message=message,
@@ -118,7 +129,27 @@ class DashboardView:
             flags=out_of_spec_flags(last_cycle.values if last_cycle is not None else {}, header),
             alarms=tuple(state.alarm_list),
             no_alarms=no_alarms_words(header, len(accepted)),
+            zero=zero_line(state.zero, header.get("resolution")),
         )
+
+
+def zero_line(zero: Mapping[str, Any], resolution: float | None) -> str:
+    """The zero in force in one compact line: ``zero x +0.0003 y -0.0001 z +0.0002 (5
+    readings)``; '' before any zero."""
+    if not zero:
+        return ""
+    from station.text import format_value
+
+    parts = [
+        f"{channel} device"
+        if spec.get("method") == "device"
+        else f"{channel} {format_value(spec.get('offset'), resolution)}"
+        for channel, spec in zero.items()
+    ]
+    counts = {spec.get("n") for spec in zero.values()}
+    n = counts.pop() if len(counts) == 1 else None
+    readings = f" ({n} readings)" if isinstance(n, int) and n > 1 else ""
+    return f"zero {' '.join(parts)}{readings}"
 
 
 class DashboardScreen(Screen[None]):
@@ -258,6 +289,10 @@ class DashboardScreen(Screen[None]):
         instruments = self.query_one(InstrumentStatus)
         if self.live:
             instruments.show(view.ports)
+            if view.zero:
+                line = status_text(view.ports)
+                line.append(f"  ·  {view.zero}")
+                instruments.update(line)
         else:
             instruments.update(Text("recorded session (read-only)", style="dim"))
         # The message line says the newest news: a capture's outcome (said by this screen) or

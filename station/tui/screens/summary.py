@@ -122,11 +122,13 @@ def _procedure_report(
     """The session's report as its analysis kind makes it (through the registry: the verdict,
     and for kinds with a report block of their own, that block), and a note saying why there
     is none when the file has nothing to analyse yet. ``session``: the file already loaded."""
+    from station.text import zero_taken
     from station.verdicts import load_session_source, report_session, session_source
 
     try:
         source = load_session_source(path) if session is None else session_source(session)
-        return report_session(source, width=REPORT_WIDTH), ()
+        zero = zero_taken(source.session.zeroes, header.get("resolution"))
+        return report_session(source, width=REPORT_WIDTH), (zero,) if zero else ()
     except StationError as error:
         return None, (error.message,)
 
