@@ -258,8 +258,9 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
         bias = per_channel(args.bias, "--bias", ["x"])["x"]
         noise = per_channel(args.noise, "--noise", ["x"])["x"]
         reference = _float(args.reference, "--reference")
-        # A software zero reads one set on the plate; a device zero reads none.
-        plate_readings = 0 if protocol.zero_command(protocol.channels[0]) else 1
+        # The station reads one set to check the frames before a session, then a software
+        # zero reads one set on the plate; a device zero reads none there.
+        plate_readings = 0 if protocol.zero_command(protocol.channels[0]) else 2
         return GaugeBenchModel(
             reference,
             bias=bias,
@@ -306,6 +307,8 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
             preload=_float(args.preload, "--preload"),
             gauge=GaugeSpec(resolution, -0.5, 0.5, "in"),
             seed=seed,
+            # The station reads one set to check the frames before the session starts.
+            lead_readings=1,
         )
     noise = per_channel(args.noise, "--noise", ["h", "v", "s"])
     try:

@@ -868,6 +868,7 @@ class TwoFixtureModel(RobotModel):
         pendant_resolution: float = 0.001,
         gauge: GaugeSpec = GaugeSpec(0.0001, -0.5, 0.5, "in"),
         seed: int = 0,
+        lead_readings: int = 0,
     ) -> None:
         if captures < 1:
             raise StationError(f"captures per placement must be 1 or more, not {captures}.")
@@ -886,6 +887,9 @@ class TwoFixtureModel(RobotModel):
         self.pendant_resolution = float(pendant_resolution)
         self._gauge = gauge
         self.seed = seed
+        self.lead_readings = max(0, int(lead_readings))
+        """Readings at home before the first placement begins (the station reads one set to
+        check the gauges' frames before a session starts)."""
         self.placement: int | None = None
         """The placement the robot is at now; None: derived from the reading index."""
 
@@ -925,11 +929,13 @@ class TwoFixtureModel(RobotModel):
         """The placement of the k-th reading."""
         if self.placement is not None:
             return self.placement
-        return k // self.readings_per_placement + 1
+        return max(k - self.lead_readings, 0) // self.readings_per_placement + 1
 
     def at_home(self, k: int) -> bool:
         """True when the k-th reading is taken at home (before the round trip)."""
-        return k % self.readings_per_placement < self.home_readings
+        if k < self.lead_readings:
+            return True
+        return (k - self.lead_readings) % self.readings_per_placement < self.home_readings
 
     def preload_of(self, number: int) -> tuple[float, float, float]:
         """How far the cube depresses each indicator at placement ``number``, about its mid

@@ -331,6 +331,7 @@ def test_capture_prints_alarms_and_asks_their_causes_only_at_a_terminal(warming_
         sys.executable, "-m", "station", "capture", "--procedure", "cycles-only",
         "--procedures", str(folder), "--port", warming_robot.url, "--protocol", "mitutoyo",
         "--robot", "R7", "--sessions", str(tmp_path / "s"), "--cycles", "40",
+        "--every", "0.01",
     ]  # fmt: skip
     env = {**os.environ, "STATION_PROCEDURES": ""}
 

@@ -43,6 +43,9 @@ def capture(
         [
             *STATION,
             "capture",
+            # A still simulated gauge: polled, paced (the robot does not leave and return).
+            "--trigger",
+            "poll",
             "--every",
             "0.01",
             "--procedure",
@@ -237,7 +240,7 @@ def test_a_repeatability_session_says_which_gauge_check_covers_it(tmp_path: Path
     finally:
         bench.send_signal(signal.SIGTERM)
         bench.communicate(timeout=10)
-    fixture, url = simulate()
+    fixture, url = simulate("--unit", "in", "--resolution", "0.0001")
     try:
         path, summary = capture(
             url, tmp_path / "sessions", "repeatability", "--cycles", "3", "--gauge", "x=MIT-0042"
@@ -270,7 +273,7 @@ def test_a_failed_gauge_check_warns_in_the_next_session(tmp_path: Path):
     from station.analysis.gauge_check import gauge_check
     from station.session.gauge_register import record_check
 
-    fixture, url = simulate()
+    fixture, url = simulate("--unit", "in", "--resolution", "0.0001")
     register = Path(os.environ["STATION_GAUGES"])
     biased = gauge_check([0.1003, 0.1004, 0.1003, 0.1002] * 7, 0.1, 0.002, resolution=0.0001)
     record_check(register, "DIAL-7", biased, when=dt.date.today(), port={"url": url, "device": "2"})
@@ -319,6 +322,7 @@ def test_a_register_that_cannot_be_written_is_a_warning_not_a_lost_check(tmp_pat
                 "capture",
                 *("--procedure", "gauge_check", "--port", url, "--protocol", "idh"),
                 *("--robot", "bench", "--sessions", str(tmp_path / "s"), "--cycles", "25"),
+                *("--every", "0.01"),
                 *("--input", "gauge=G-1", "--input", "reference=0.1", "--input", "tolerance=0.004"),
             ],
             capture_output=True,

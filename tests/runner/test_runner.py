@@ -49,7 +49,7 @@ def batch_analysis(path: Path):
     session = load_session(path, recover=False)
     return analyze(
         session.channel_values(),
-        analysis_config(session.header),
+        analysis_config(session.header, session.zeroes),
         excluded_cycles=session.excluded_cycles,
         cycles=session.channel_cycles(),
         # The reading times the live analysis' drift trend runs on, as `station analyze` does.
