@@ -148,7 +148,10 @@ class StationApp(App[int]):
         """SIGHUP or SIGTERM: write ``interrupted`` (the session stays resumable), then exit."""
         name = signal.Signals(signum).name
         self.interrupt_session(name)
-        self.exit(HANGUP_EXIT_CODES.get(signum, 1))
+        # Textual's signature is exit(result, return_code): the code must go by name, or it
+        # becomes the result and the process exits 0.
+        code = HANGUP_EXIT_CODES.get(signum, 1)
+        self.exit(code, return_code=code)
 
     def interrupt_session(self, reason: str) -> None:
         """Leave the running session resumable: the runner writes an ``interrupted`` event."""
