@@ -173,7 +173,41 @@ class StationApp(App[int]):
             gauges.stop()
 
     async def action_quit_station(self) -> None:
-        """Ctrl+C: leave an unfinished session resumable, then quit."""
+        """Ctrl+C: leave an unfinished session resumable, then quit. Inside a dialog (a note
+        being typed, a question) it asks first, naming any half-typed text, so a stray Ctrl+C
+        does not throw the text away; a second Ctrl+C on that question quits."""
+        from textual.screen import ModalScreen
+
+        from station.tui.screens.dialogs import ConfirmScreen, QuitQuestion
+
+        screen = self.screen
+        if isinstance(screen, QuitQuestion):
+            self._quit_now()
+            return
+        if isinstance(screen, ModalScreen):
+            unsaved = ""
+            for widget in screen.query("Input"):
+                value = str(getattr(widget, "value", "")).strip()
+                if value:
+                    unsaved = value
+                    break
+            detail = "The session stays resumable."
+            if unsaved:
+                detail = (
+                    f"What you typed is not saved: “{plain(unsaved)}”. Press n to go back and "
+                    "finish it (Enter saves it). " + detail
+                )
+            question: ConfirmScreen = QuitQuestion("Quit station now?", detail)
+
+            def answered(yes: bool | None) -> None:
+                if yes:
+                    self._quit_now()
+
+            self.push_screen(question, answered)
+            return
+        self._quit_now()
+
+    def _quit_now(self) -> None:
         self.interrupt_session("quit")
         self.exit(0)
 

@@ -79,6 +79,10 @@ class ConfirmScreen(ModalScreen[bool]):
         self.dismiss(answer)
 
 
+class QuitQuestion(ConfirmScreen):
+    """Ctrl+C inside a dialog: quit now? (n goes back to the dialog, its text kept)."""
+
+
 HELP_TEXT = """\
 [b]Home[/b]  ↑ ↓ choose · Enter open · n new session · r resume · v review · q quit
 
