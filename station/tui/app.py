@@ -26,8 +26,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from textual import events
 from textual.app import App
 from textual.binding import Binding
+from textual.geometry import Size
 
 from station.errors import StationError
 from station.plain import plain
@@ -131,11 +133,41 @@ class StationApp(App[int]):
                 pass  # not the main thread (some test harnesses): nothing to restore then
         from station.tui.screens.home import HomeScreen
 
+        self.screen_change_signal.subscribe(self, lambda _screen: self.fit_to_terminal())
         self.push_screen(HomeScreen())
         if self.config.autopilot:
             from station.tui.autopilot import run_autopilot
 
             self.run_worker(run_autopilot(self), group="autopilot", exclusive=True)
+
+    def on_resize(self, event: events.Resize) -> None:
+        """Show the "terminal too small" notice, or take it away (this runs before Textual's
+        own handler stores the new size, so the size comes from the event)."""
+        self.fit_to_terminal(event.size)
+
+    def fit_to_terminal(self, size: Size | None = None) -> None:
+        """Below the smallest size the screens are laid out for, the current screen shows one
+        sentence (``TooSmallNotice``) instead of tables that lost their names and values."""
+        from station.tui.widgets.too_small import TooSmallNotice, too_small
+
+        size = size or self.size
+        small = too_small(size)
+        if small != self.has_class("-too-small"):
+            self.set_class(small, "-too-small")
+            # Textual restyles only the top screen on an app class change; the screens below
+            # are laid out at the new size too, and must not lay out their tables in 6 columns.
+            for screen in self.screen_stack:
+                screen.update_node_styles(animate=False)
+        if not small:
+            return
+        screen = self.screen
+        notices = screen.query(TooSmallNotice)
+        if notices:
+            notices.first().show_size(size)
+        else:
+            notice = TooSmallNotice()
+            screen.mount(notice)
+            notice.show_size(size)
 
     def on_unmount(self) -> None:
         """Remove the signal handlers and stop the instruments."""

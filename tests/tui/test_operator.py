@@ -52,3 +52,42 @@ async def test_ctrl_c_in_the_note_dialog_asks_and_keeps_the_typed_note(
     session = load_session(next(tmp_path.glob("*.jsonl")), recover=False)
     assert any(note.get("text") == "dial 2 loose" for note in session.notes)
     assert session.status == "interrupted"
+
+
+def _visible_text(app: StationApp) -> str:
+    return " ".join(str(w.render()) for w in app.screen.query(Static) if w.display and w.region)
+
+
+async def test_a_terminal_below_the_minimum_shows_a_notice_not_broken_tables(
+    tmp_path: Path, fixture_pty, tui
+) -> None:
+    from station.tui.screens.dashboard import DashboardScreen
+    from station.tui.widgets.too_small import TooSmallNotice
+
+    app = _app(tmp_path)
+    async with app.run_test(size=(60, 20)) as pilot:
+        await pilot.pause()
+        notice = app.screen.query_one(TooSmallNotice)
+        assert notice.region.width == 60 and "Terminal too small: 60×20" in str(notice.render())
+        assert not app.screen.query_one("#home-choices").region
+        assert "Sessions folder" not in _visible_text(app)
+        await pilot.resize_terminal(80, 24)
+        await pilot.pause(0.2)
+        assert not app.screen.query_one(TooSmallNotice).region
+        assert app.screen.query_one("#home-choices").region
+        assert "Sessions folder" in _visible_text(app)
+        await tui.open_setup(pilot, "R4", fixture_pty.url)
+        await pilot.press("f2")
+        await tui.walk_checklist(pilot)
+        await tui.capture_one(pilot)
+        assert isinstance(app.screen, DashboardScreen)
+        # Six columns: the notice, no crash; captures still work.
+        await pilot.resize_terminal(6, 10)
+        await pilot.pause(0.2)
+        await tui.capture_one(pilot)
+        notice = app.screen.query_one(TooSmallNotice)
+        assert notice.region.width == 6
+        await pilot.resize_terminal(80, 24)
+        await pilot.pause(0.2)
+        assert not app.screen.query_one(TooSmallNotice).region
+        assert len(app.runner.state().cycles) == 2
