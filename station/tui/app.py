@@ -96,7 +96,15 @@ class StationApp(App[int]):
 
     def __init__(self, config: StationConfig) -> None:
         super().__init__()
+        from station.tui.theme import HIGH_CONTRAST_THEME, apply_palette, wanted_theme
+
         self.config = config
+        # Verdicts and alarms by text attributes; without colour they name no colour at all.
+        self.register_theme(HIGH_CONTRAST_THEME)
+        theme = wanted_theme()
+        if theme is not None:
+            self.theme = theme
+        apply_palette(colour=not self.no_color and theme is None)
         self.runner: Runner | None = None
         self.session_header: dict[str, Any] = {}
         """The running session's header fields (robot, procedure, channels, unit, limits)."""

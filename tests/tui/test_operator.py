@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from textual.widgets import Input, Static
 
 from station.session.model import load_session
@@ -91,3 +92,90 @@ async def test_a_terminal_below_the_minimum_shows_a_notice_not_broken_tables(
         await pilot.pause(0.2)
         assert not app.screen.query_one(TooSmallNotice).region
         assert len(app.runner.state().cycles) == 2
+
+
+# ---- NO_COLOR: the verdict and the alarms by attribute, never only by colour or shade -------
+
+SNAPSHOT_SESSIONS = Path(__file__).resolve().parent / "snapshots"
+
+
+def _luminance(color) -> float:
+    red, green, blue = color.get_truecolor() if color is not None else (128, 128, 128)
+
+    def channel(value: int) -> float:
+        c = value / 255
+        return c / 12.92 if c <= 0.03928 else ((c + 0.055) / 1.055) ** 2.4
+
+    return 0.2126 * channel(red) + 0.7152 * channel(green) + 0.0722 * channel(blue)
+
+
+def _segments_of(app: StationApp, word: str) -> list:
+    """The drawn segments (after Textual's NO_COLOR filter) that carry ``word``."""
+    found = []
+    for strip in app.screen._compositor.render_strips():
+        for segment in strip:
+            if word in segment.text:
+                found.append(segment)
+    assert found, f"{word!r} is not on the screen"
+    return found
+
+
+def assert_reads_without_colour(segment) -> None:
+    """Bold or reverse video, not dim, and a foreground that stands off its background (the
+    WCAG contrast ratio of 4.5: grey 237 on 234, the issue's verdict, is 1.1)."""
+    style = segment.style
+    assert style.bold or style.reverse, f"{segment.text!r} only by colour: {style}"
+    assert not style.dim, f"{segment.text!r} is dim: {style}"
+    fore, back = _luminance(style.color), _luminance(style.bgcolor)
+    ratio = (max(fore, back) + 0.05) / (min(fore, back) + 0.05)
+    assert ratio >= 4.5, f"{segment.text!r} is a shade on a shade ({ratio:.1f}): {style}"
+
+
+@pytest.mark.parametrize(
+    ("variable", "value"), [("NO_COLOR", "1"), ("STATION_THEME", "high-contrast")]
+)
+async def test_no_color_summary_verdict_reads_by_attribute(
+    monkeypatch, tui, variable: str, value: str
+) -> None:
+    from station.tui.screens.summary import SummaryScreen
+
+    monkeypatch.chdir(SNAPSHOT_SESSIONS)
+    monkeypatch.setenv(variable, value)
+    app = _app(Path("sessions"))
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("v")
+        await pilot.pause()
+        await pilot.press("enter")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, SummaryScreen))
+        await pilot.pause(0.2)
+        verdicts = _segments_of(app, "CAPABLE")
+        for segment in verdicts:
+            assert_reads_without_colour(segment)
+        # NOT CAPABLE stands apart from CAPABLE by more than a shade: reverse video.
+        for segment in verdicts:
+            if "NOT CAPABLE" in segment.text:
+                assert segment.style.reverse
+
+
+async def test_no_color_alarm_lines_read_by_attribute(
+    tmp_path: Path, monkeypatch, fixture_pty, tui
+) -> None:
+    from station.tui.widgets.alarm_log import AlarmLog
+
+    monkeypatch.setenv("NO_COLOR", "1")
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await tui.open_setup(pilot, "R1", fixture_pty.url)
+        await pilot.press("f2")
+        await tui.walk_checklist(pilot)
+        log = app.screen.query_one(AlarmLog)
+        for _ in range(25):
+            await tui.capture_one(pilot)
+            if "⚠" in str(log.render()):
+                break
+        await pilot.pause(0.3)
+        assert "⚠" in str(log.render()), "the seeded simulator's warming-up z raised no alarm"
+        for segment in _segments_of(app, "alarms ("):
+            assert_reads_without_colour(segment)
+        for segment in _segments_of(app, "⚠"):
+            assert_reads_without_colour(segment)

@@ -9,6 +9,7 @@ from rich.text import Text
 from textual.widgets import Static
 
 from station.tui.text import shown_line
+from station.tui.theme import ALARM_STYLES
 
 
 def alarm_lines(
@@ -54,7 +55,7 @@ class AlarmLog(Static):
             return
         self._lines = list(lines)
         if not lines:
-            self.update(Text("alarms: none", style="dim"))
+            self.update(Text("alarms: none", style=ALARM_STYLES["none"]))
             return
         shown = lines[-self.max_shown :]
         head = (
@@ -62,7 +63,7 @@ class AlarmLog(Static):
             if len(lines) <= self.max_shown
             else (f"alarms ({len(lines)}, newest {len(shown)}):")
         )
-        text = Text(head, style="bold red", no_wrap=True, overflow="ellipsis")
+        text = Text(head, style=ALARM_STYLES["head"], no_wrap=True, overflow="ellipsis")
         for line in shown:
-            text.append("\n⚠ " + shown_line(line), style="red")
+            text.append("\n⚠ " + shown_line(line), style=ALARM_STYLES["line"])
         self.update(text)
