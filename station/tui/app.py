@@ -21,8 +21,9 @@ import asyncio
 import signal
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -37,6 +38,9 @@ from station.tui.messages import RunnerChanged
 from station.tui.remedies import explained
 
 if TYPE_CHECKING:
+    from textual.app import SystemCommand
+    from textual.screen import Screen
+
     from station.procedures import ProcedureCatalog
     from station.run import Runner, RunnerNotice, RunnerState, SessionSetup
 
@@ -91,8 +95,11 @@ class StationApp(App[int]):
 
     CSS_PATH = Path(__file__).with_name("station.tcss")
     TITLE = "station"
-    ENABLE_COMMAND_PALETTE = False
-    BINDINGS = [Binding("ctrl+c", "quit_station", "Quit", show=False, priority=True)]
+    COMMAND_PALETTE_BINDING = "ctrl+p"
+    BINDINGS = [
+        Binding("ctrl+c", "quit_station", "Quit", show=False, priority=True),
+        Binding("question_mark", "keys", "Keys", show=False),
+    ]
 
     def __init__(self, config: StationConfig) -> None:
         super().__init__()
@@ -250,6 +257,41 @@ class StationApp(App[int]):
     def _quit_now(self) -> None:
         self.interrupt_session("quit")
         self.exit(0)
+
+    def get_system_commands(self, screen: Screen[Any]) -> Iterable[SystemCommand]:
+        """The command palette (Ctrl+P): every action of the current screen by name, with its
+        key, and this screen's keys. Textual's own entries (quit without writing
+        ``interrupted``, screenshots) are left out on purpose."""
+        from textual.app import SystemCommand
+
+        from station.tui.screens.dialogs import screen_keys
+
+        seen: set[str] = set()
+        for active in screen.active_bindings.values():
+            binding = active.binding
+            if not binding.description or binding.action in seen or not active.enabled:
+                continue
+            if binding.action in ("command_palette", "keys"):
+                continue
+            seen.add(binding.action)
+            key = self.get_key_display(binding)
+            yield SystemCommand(
+                binding.description,
+                f"key {key}",
+                partial(self._run_from_palette, binding.action, active.node),
+            )
+        if screen_keys(screen):
+            yield SystemCommand("Keys of this screen", "key ?", self.action_keys)
+
+    async def _run_from_palette(self, action: str, node: Any) -> None:
+        await self.run_action(action, node)
+
+    def action_keys(self) -> None:
+        """``?``: the keys of the current screen (and the help)."""
+        from station.tui.screens.dialogs import HelpScreen
+
+        if not isinstance(self.screen, HelpScreen):
+            self.push_screen(HelpScreen())
 
     def warm_up_analysis(self) -> None:
         """Load the analysis (numpy, scipy: about half a second) on a thread, early, so that

@@ -179,3 +179,38 @@ async def test_no_color_alarm_lines_read_by_attribute(
             assert_reads_without_colour(segment)
         for segment in _segments_of(app, "⚠"):
             assert_reads_without_colour(segment)
+
+
+async def test_command_palette_runs_the_screens_actions_and_question_mark_lists_keys(
+    tmp_path: Path, fixture_pty, tui
+) -> None:
+    from textual.command import CommandPalette
+
+    from station.tui.screens.dashboard import DashboardScreen
+    from station.tui.screens.dialogs import HelpScreen
+
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await tui.open_setup(pilot, "R7", fixture_pty.url)
+        await pilot.press("f2")
+        await tui.walk_checklist(pilot)
+        assert isinstance(app.screen, DashboardScreen)
+        # ? lists the keys of this screen, by key and by what it does.
+        await pilot.press("question_mark")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, HelpScreen))
+        keys = str(app.screen.query_one("#help-keys", Static).render())
+        for expected in ("space", "Capture", "Reject", "Pause", "Finish", "Ctrl+P"):
+            assert expected.lower() in keys.lower(), keys
+        await pilot.press("escape")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, DashboardScreen))
+        # Ctrl+P: every action by name; "Pause" runs the dashboard's own action.
+        await pilot.press("ctrl+p")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, CommandPalette))
+        await pilot.press(*"Pause")
+        await pilot.pause(0.5)
+        await pilot.press("enter")
+        await tui.wait_until(pilot, lambda: app.runner.state().status == "paused")
+        assert isinstance(app.screen, DashboardScreen)
+        commands = [c.title for c in app.get_system_commands(app.screen)]
+        for expected in ("Capture", "Reject", "Note", "Finish", "Leave", "Keys of this screen"):
+            assert expected in commands, commands

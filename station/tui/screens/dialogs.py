@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Vertical, VerticalScroll
-from textual.screen import ModalScreen
+from textual.screen import ModalScreen, Screen
 from textual.widgets import Footer, Input, Static
 
 from station.tui.text import shown
@@ -109,6 +110,22 @@ UNDEFINED when there are no limits or too few readings.
 """
 
 
+def screen_keys(screen: Screen[object]) -> list[tuple[str, str]]:
+    """The keys ``screen`` answers now (its own, its focused widget's and the app's), each with
+    what it does, in the order the footer shows them; keys without a description are left out
+    (they repeat one that has it, e.g. ``x`` beside Tab for the axis)."""
+    app = screen.app
+    keys: list[tuple[str, str]] = []
+    seen: set[str] = set()
+    for key, active in screen.active_bindings.items():
+        binding = active.binding
+        if not binding.description or binding.action in seen or not active.enabled:
+            continue
+        seen.add(binding.action)
+        keys.append((app.get_key_display(binding), binding.description))
+    return keys
+
+
 class HelpScreen(ModalScreen[None]):
     """Every key of every screen, and what the verdict words mean."""
 
@@ -119,8 +136,17 @@ class HelpScreen(ModalScreen[None]):
     ]
 
     def compose(self) -> ComposeResult:
-        """The help text in a scrolling box."""
+        """The keys of the screen underneath first, then the help text, in a scrolling box."""
         with VerticalScroll(classes="dialog help"):
+            underneath = [screen for screen in self.app.screen_stack if screen is not self]
+            keys = screen_keys(underneath[-1]) if underneath else []
+            if keys:
+                text = Text("Keys of this screen\n", style="bold")
+                for key, description in keys:
+                    text.append(f"  {key:<12}", style="bold")
+                    text.append(f" {description}\n")
+                text.append("  Ctrl+P       every action of this screen by name\n")
+                yield Static(text, id="help-keys")
             yield Static(HELP_TEXT)
         yield Footer()
 
