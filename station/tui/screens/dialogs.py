@@ -117,7 +117,7 @@ def screen_keys(screen: Screen[object]) -> list[tuple[str, str]]:
     app = screen.app
     keys: list[tuple[str, str]] = []
     seen: set[str] = set()
-    for key, active in screen.active_bindings.items():
+    for active in screen.active_bindings.values():
         binding = active.binding
         if not binding.description or binding.action in seen or not active.enabled:
             continue
