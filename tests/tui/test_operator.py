@@ -214,3 +214,167 @@ async def test_command_palette_runs_the_screens_actions_and_question_mark_lists_
         commands = [c.title for c in app.get_system_commands(app.screen)]
         for expected in ("Capture", "Reject", "Note", "Finish", "Leave", "Keys of this screen"):
             assert expected in commands, commands
+
+
+# ---- the set-up form follows the focus --------------------------------------------------------
+
+
+def _in_view(screen, widget) -> bool:
+    """The widget is drawn whole inside the scrolling form's visible area."""
+    form = screen.query_one("#setup-form")
+    region = widget.region
+    return bool(region) and form.region.contains_region(region)
+
+
+async def test_the_setup_form_follows_the_focus(tmp_path: Path, monkeypatch, tui) -> None:
+    from textual.widgets import Button
+
+    from station.tui.screens.setup import SetupScreen
+
+    monkeypatch.setenv("NO_COLOR", "1")
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("n")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, SetupScreen))
+        await pilot.pause(0.3)
+        screen = app.screen
+        form = screen.query_one("#setup-form")
+        # Opens at the top, on the robot, and the Start button is always in view.
+        assert form.scroll_y == 0 and screen.focused.id == "robot"
+        assert screen.query_one("#start", Button).region
+        # Tab walks every field; each one is scrolled into view, its label in reverse video.
+        seen = []
+        for _ in range(14):
+            await pilot.press("tab")
+            await pilot.pause(0.1)
+            focused = screen.focused
+            if isinstance(focused, Button):
+                break
+            seen.append(focused.id)
+            assert _in_view(screen, focused), f"{focused.id} is off-screen after Tab"
+            label = focused.parent.query_one(".field-label")
+            strips = app.screen._compositor.render_strips()
+            row = strips[label.region.y]
+            label_text = str(label.render()).strip()
+            segment = next(s for s in row if label_text.split()[0] in s.text)
+            assert segment.style.reverse, f"the focused {focused.id}'s label is not marked"
+        assert {"procedure", "unit", "port", "protocol", "trigger", "map"} <= set(seen)
+        # An unfocused field's label is not reversed: the mark means focus.
+        strips = app.screen._compositor.render_strips()
+        unit_label = screen.query_one("#unit").parent.query_one(".field-label")
+        assert not any(
+            s.style and s.style.reverse for s in strips[unit_label.region.y] if "Unit" in s.text
+        )
+
+        # F2 with errors: the focus goes to the first bad field, in view.
+        await pilot.press("f2")
+        await pilot.pause(0.3)
+        assert screen.focused.id == "robot"
+        assert _in_view(screen, screen.focused)
+        port_error = screen.query_one("#port-error", Static)
+        assert "Name the port" in str(port_error.render()) and port_error.has_class("-shown")
+        # Filling the port in clears its stale sentence at once.
+        screen.query_one("#port", Input).value = "/dev/ttyUSB9"
+        await pilot.pause(0.1)
+        assert not port_error.has_class("-shown")
+
+
+async def test_limits_far_from_the_resolution_ask_naming_the_ratio(
+    tmp_path: Path, fixture_pty, tui
+) -> None:
+    from station.tui.screens.checklist import ChecklistScreen
+    from station.tui.screens.dialogs import ConfirmScreen
+    from station.tui.screens.setup import SetupScreen
+
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await tui.open_setup(pilot, "R5", fixture_pty.url)
+        screen = app.screen
+        screen.query_one("#limits-x", Input).value = "25"  # ±25 in with a 0.0001 in gauge
+        await pilot.press("f2")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, ConfirmScreen))
+        question = " ".join(str(s.render()) for s in app.screen.query(Static))
+        assert "500,000 gauge steps" in question and "x:" in question
+        await pilot.press("n")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, SetupScreen))
+        assert app.screen.focused.id == "limits-x"
+        assert app.runner is None and not list(tmp_path.glob("*.jsonl"))
+        # Too narrow: 0.0003 wide is 3 steps.
+        app.screen.query_one("#limits-x", Input).value = "±0.00015"
+        await pilot.press("f2")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, ConfirmScreen))
+        question = " ".join(str(s.render()) for s in app.screen.query(Static))
+        assert "only 3 gauge steps" in question
+        await pilot.press("y")  # confirmed: it starts
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen))
+
+
+# ---- the set-up remembered between sessions -------------------------------------------------
+
+
+async def test_the_last_setup_is_offered_prefilled_but_never_applied_to_a_resume(
+    tmp_path: Path, fixture_pty, tui
+) -> None:
+    from textual.widgets import Select
+
+    from station.session.remembered import load_remembered, settings_path
+    from station.tui.screens.checklist import ChecklistScreen
+    from station.tui.screens.dialogs import ConfirmScreen
+    from station.tui.screens.home import HomeScreen
+    from station.tui.screens.setup import SetupScreen
+
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await tui.open_setup(pilot, "cell-4 KR16", fixture_pty.url, operator="jdoe")
+        app.screen.query_one("#map", Input).value = "1=x, 2=y, 3=z"
+        app.screen.query_one("#trigger", Select).value = "stable"
+        await pilot.pause()
+        await pilot.press("f2")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen))
+        await pilot.press("q")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, ConfirmScreen))
+        await pilot.press("y")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, HomeScreen))
+
+    remembered, problem = load_remembered()
+    assert problem == "" and settings_path().is_file()
+    assert remembered.robot == "cell-4 KR16" and remembered.trigger == "stable"
+    assert remembered.channel_map == "1=x,2=y,3=z"
+
+    # The next new session offers them, and says where they come from.
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("n")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, SetupScreen))
+        await pilot.pause(0.2)
+        screen = app.screen
+        assert screen.query_one("#robot", Input).value == "cell-4 KR16"
+        assert screen.query_one("#operator", Input).value == "jdoe"
+        assert screen.query_one("#port", Input).value == fixture_pty.url
+        assert screen.query_one("#map", Input).value == "1=x,2=y,3=z"
+        assert screen.query_one("#trigger", Select).value == "stable"
+        assert "last session" in str(screen.query_one("#setup-hint", Static).render())
+        await pilot.press("escape")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, HomeScreen))
+
+    # A resume shows what its file recorded, not the remembered line.
+    from station.session.remembered import RememberedSetup, save_remembered
+
+    save_remembered(RememberedSetup(robot="other", port="/dev/ttyUSB7", trigger="push"))
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("r")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, SetupScreen))
+        await pilot.pause(0.2)
+        assert app.screen.query_one("#port", Input).value == fixture_pty.url
+        assert app.screen.query_one("#robot", Input).value == "cell-4 KR16"
+        assert app.screen.query_one("#trigger", Select).value == "stable"
+
+
+def test_a_damaged_settings_file_is_said_not_fatal(tmp_path: Path) -> None:
+    from station.session.remembered import load_remembered
+
+    damaged = tmp_path / "settings.toml"
+    damaged.write_text("[last\nrobot = 'R1'", encoding="utf-8")
+    remembered, problem = load_remembered(damaged)
+    assert remembered.filled() == {} and "not valid TOML" in problem

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rich.text import Text
-from textual import work
+from textual import events, work
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, VerticalScroll
@@ -30,7 +30,7 @@ from station.tui.app import PortNotOpen
 from station.tui.messages import ConnectionTested
 from station.tui.remedies import explained
 from station.tui.text import shown
-from station.tui.widgets.fields import say
+from station.tui.widgets.fields import mark_focused_row, say
 
 if TYPE_CHECKING:
     from station.procedures import Procedure
@@ -143,6 +143,8 @@ class SetupScreen(Screen[None]):
         self._header: dict[str, Any] = {}
         self._testing = False
         self._initial: dict[str, str] = {}
+        self._confirmed_limits: tuple[Any, ...] | None = None
+        """The limits and resolution the operator confirmed despite an implausible ratio."""
 
     # -- layout ---------------------------------------------------------------------------
 
@@ -166,6 +168,8 @@ class SetupScreen(Screen[None]):
         header = self._header
         recorded_port = (header.get("instruments", {}).get("ports") or [{}])[0]
         resuming = self.resume_path is not None
+        # The last set-up, offered (never applied to a resume, never over the demo's line).
+        last = {} if resuming or demo is not None else self._remembered()
 
         title = (
             f"Resume {self.resume_path.name}"
@@ -176,6 +180,8 @@ class SetupScreen(Screen[None]):
         hint = "Tab / Shift+Tab move between fields · F3 tests the line · F2 starts"
         if demo is not None and not resuming:
             hint = "Pre-filled for the demo: press F2 to start (F3 shows live readings first)"
+        if last:
+            hint = "Pre-filled from your last session: check robot and line · F2 starts"
         yield Static(Text(hint, style="bold cyan"), id="setup-hint")
         with VerticalScroll(id="setup-form"):
             if resuming:
@@ -184,7 +190,9 @@ class SetupScreen(Screen[None]):
                 "Robot",
                 Input(
                     compact=True,
-                    value=plain(header.get("robot") or (demo.robot if demo else "")),
+                    value=plain(
+                        header.get("robot") or (demo.robot if demo else last.get("robot", ""))
+                    ),
                     placeholder="name or asset number of the robot under test",
                     id="robot",
                     disabled=resuming,
@@ -195,7 +203,7 @@ class SetupScreen(Screen[None]):
                 "Operator",
                 Input(
                     compact=True,
-                    value=plain(header.get("operator") or _login_name()),
+                    value=plain(header.get("operator") or last.get("operator") or _login_name()),
                     id="operator",
                     disabled=resuming,
                 ),
@@ -268,7 +276,7 @@ class SetupScreen(Screen[None]):
                 count.hint,
             )
             detected = [(f"{p.device}  {p.description}", p.device) for p in list_ports()]
-            port_value = recorded_port.get("url") or (demo.url if demo else "")
+            port_value = recorded_port.get("url") or (demo.url if demo else last.get("port", ""))
             yield from _field(
                 "Detected",
                 self._select(
@@ -289,7 +297,11 @@ class SetupScreen(Screen[None]):
                 "port",
             )
             protocols = protocol_names()
-            protocol = recorded_port.get("protocol") or (demo.protocol if demo else protocols[0])
+            protocol = recorded_port.get("protocol") or (
+                demo.protocol if demo else last.get("protocol", protocols[0])
+            )
+            if protocol not in protocols:
+                protocol = protocols[0]
             yield from _field(
                 "Protocol",
                 self._select("protocol", [(name, name) for name in protocols], protocol),
@@ -300,31 +312,36 @@ class SetupScreen(Screen[None]):
                 if demo
                 else {str(i + 1): ch for i, ch in enumerate(procedure.channels)}
             )
+            map_text = ",".join(f"{k}={v}" for k, v in channel_map.items())
+            if last.get("channel_map") and not recorded_port.get("map"):
+                map_text = last["channel_map"]
             yield from _field(
                 "Channel map",
-                Input(
-                    compact=True,
-                    value=",".join(f"{k}={v}" for k, v in channel_map.items()),
-                    id="map",
-                ),
+                Input(compact=True, value=map_text, id="map"),
                 "map",
                 "device channel = axis, e.g. 1=x,2=y,3=z",
             )
             trigger = header.get("instruments", {}).get("trigger") or (
-                demo.trigger if demo else "poll"
+                demo.trigger if demo else last.get("trigger", "poll")
             )
+            if trigger not in {value for _, value in TRIGGER_CHOICES}:
+                trigger = "poll"
             yield from _field(
                 "Trigger",
                 self._select("trigger", TRIGGER_CHOICES, trigger, disabled=resuming),
                 "trigger",
             )
-            yield Static("", classes="field-error", id="setup-error")
             yield Static("", id="test-output")
-            with Horizontal(id="setup-buttons"):
-                yield Button("Test connection (F3)", id="test")
-                yield Button(
-                    "Resume (F2)" if resuming else "Start (F2)", id="start", variant="primary"
-                )
+        # Outside the scrolling form, so the buttons and the form's verdict stay in view.
+        yield Static("", classes="field-error", id="setup-error")
+        with Horizontal(id="setup-buttons"):
+            yield Button("Test connection (F3)", id="test", compact=True)
+            yield Button(
+                "Resume (F2)" if resuming else "Start (F2)",
+                id="start",
+                variant="primary",
+                compact=True,
+            )
         yield Footer()
 
     def _select(self, field_id: str, options: Any, value: str, **options_kw: Any) -> Select:
@@ -346,17 +363,57 @@ class SetupScreen(Screen[None]):
                 widget.value = value  # type: ignore[attr-defined]
                 self._initial[field_id] = value
         if self.app.config.demo is not None and self.resume_path is None:
-            # Everything is pre-filled: Enter or Space starts at once.
-            self.query_one("#start", Button).focus()
+            # Everything is pre-filled: Enter or Space starts at once (the button is in view
+            # below the form, which opens at its top).
+            self.query_one("#start", Button).focus(scroll_visible=False)
         else:
             first = "#port" if self.resume_path is not None else "#robot"
             self.query_one(first, Input).focus()
+        form = self.query_one("#setup-form", VerticalScroll)
+        if self.resume_path is None:
+            self.call_after_refresh(lambda: form.scroll_home(animate=False))
+
+    def _remembered(self) -> dict[str, str]:
+        """The last set-up from the settings file, by field name (empty when there is none
+        or it could not be read; the reason is said as a notification)."""
+        from station.session.remembered import load_remembered
+
+        remembered, problem = load_remembered()
+        if problem:
+            self.app.notify(plain(problem), severity="warning", markup=False)
+        return remembered.filled()
+
+    def remember(self, setup: Any) -> None:
+        """Keep this set-up's names and line for the next new session (not in the demo: its
+        simulated port means nothing tomorrow). A file that cannot be written is said, not
+        fatal."""
+        from station.session.remembered import RememberedSetup, save_remembered
+
+        if self.app.config.demo is not None or not setup.ports:
+            return
+        port = setup.ports[0]
+        try:
+            save_remembered(
+                RememberedSetup(
+                    robot=setup.robot,
+                    operator=setup.operator,
+                    port=port.url,
+                    protocol=port.protocol,
+                    channel_map=",".join(f"{k}={v}" for k, v in port.channel_map.items()),
+                    trigger=str(setup.trigger),
+                )
+            )
+        except (OSError, StationError) as error:
+            self.app.notify(
+                plain(f"the set-up was not remembered: {error}"), severity="warning", markup=False
+            )
 
     # -- events ---------------------------------------------------------------------------
 
     def on_select_changed(self, event: Select.Changed) -> None:
         """A detected port fills the port field; another procedure rebuilds the form for its
         channels and defaults, keeping what was typed about the robot and the line."""
+        self._clear_stale(event.select.id)
         if event.select.id == "detected" and event.value not in (TYPED_PORT, Select.NULL):
             self.query_one("#port", Input).value = str(event.value)
         elif (
@@ -370,6 +427,26 @@ class SetupScreen(Screen[None]):
             )
             kept = {key: self._value(key) for key in keys}
             self.app.switch_screen(SetupScreen(procedure_id=str(event.value), typed=kept))
+
+    def on_descendant_focus(self, event: events.DescendantFocus) -> None:
+        """Mark the focused field's row (its label in reverse video)."""
+        mark_focused_row(self, event.widget)
+
+    def on_input_changed(self, event: Input.Changed) -> None:
+        """A field the operator corrects loses its old error sentence at once (it is checked
+        again at F2)."""
+        self._clear_stale(event.input.id)
+
+    def _clear_stale(self, field_id: str | None) -> None:
+        if not field_id:
+            return
+        errors = self.query(f"#{field_id}-error")
+        if errors and errors.first().has_class("-shown"):
+            say(errors.first(), "")  # type: ignore[arg-type]
+            if field_id == "port":
+                # The port's sentence may come from the line that did not open.
+                say(self.query_one("#setup-error", Static), "")
+        self._confirmed_limits = None
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
         """Enter in a field moves to the next one, as in a paper form."""
@@ -414,7 +491,7 @@ class SetupScreen(Screen[None]):
             self.call_after_refresh(self._show_buttons)
 
     def _show_buttons(self) -> None:
-        self.query_one("#setup-buttons").scroll_visible(animate=False)
+        self.query_one("#test-output").scroll_visible(animate=False)
 
     def _refuse(self, errors: dict[str, str]) -> None:
         """Put each sentence under its field, and take the operator to the first one."""
@@ -422,9 +499,23 @@ class SetupScreen(Screen[None]):
             self._say(field_id, sentence)
         self._say("setup", f"{len(errors)} field(s) to correct above.")
         first_id = next(iter(errors))
-        self.query_one(f"#{first_id}").focus()
+        field = self.query_one(f"#{first_id}")
         sentence = self.query_one(f"#{first_id}-error")
-        self.call_after_refresh(lambda: sentence.scroll_visible(animate=False))
+        field.focus(scroll_visible=False)
+
+        def show_first() -> None:
+            # Once the error lines are laid out: the field's whole row and its sentence.
+            form = self.query_one("#setup-form", VerticalScroll)
+            row = field.parent if field.parent is not None else field
+            top = min(row.virtual_region.y, sentence.virtual_region.y)
+            bottom = sentence.virtual_region.bottom
+            if (
+                top < form.scroll_y
+                or bottom > form.scroll_y + form.scrollable_content_region.height
+            ):
+                form.scroll_to(y=max(0, top - 1), animate=False, immediate=True)
+
+        self.call_after_refresh(show_first)
 
     def _clear_errors(self) -> None:
         for error in self.query(".field-error"):
@@ -542,12 +633,55 @@ class SetupScreen(Screen[None]):
         setup = self.read_setup()
         if setup is None:
             return
+        doubts = self._implausible(setup)
+        if doubts and self._confirmed_limits != self._limits_key(setup):
+            from station.tui.screens.dialogs import ConfirmScreen
+
+            def answered(yes: bool | None) -> None:
+                if yes:
+                    self._confirmed_limits = self._limits_key(setup)
+                    self.action_start()
+                else:
+                    first = next(iter(doubts))
+                    self.query_one(f"#limits-{first}", Input).focus()
+
+            self.app.push_screen(
+                ConfirmScreen(
+                    "Start with these limits?",
+                    " ".join(doubts.values()) + " y starts anyway; n goes back to the limits.",
+                ),
+                answered,
+            )
+            return
         try:
             self.app.start_session(setup)
         except PortNotOpen as error:
             self._refuse({"port": explained(error)})
+            return
         except StationError as error:
             self._say("setup", explained(error))
+            return
+        self.remember(setup)
+
+    @staticmethod
+    def _limits_key(setup: Any) -> tuple[Any, ...]:
+        return (
+            setup.resolution,
+            tuple(sorted((c, lim.lsl, lim.usl, lim.nominal) for c, lim in setup.limits.items())),
+        )
+
+    def _implausible(self, setup: Any) -> dict[str, str]:
+        """Channel -> a sentence for each tolerance under 10 or over 100,000 gauge steps."""
+        from station.analysis.tolerance import implausible_tolerance
+
+        doubts: dict[str, str] = {}
+        for channel, limits in setup.limits.items():
+            sentence = implausible_tolerance(
+                channel, limits.lsl, limits.usl, limits.nominal, setup.resolution, setup.unit
+            )
+            if sentence:
+                doubts[channel] = sentence
+        return doubts
 
     def action_test_connection(self) -> None:
         """Open the port and show a few readings; nothing is recorded."""
