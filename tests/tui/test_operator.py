@@ -378,3 +378,90 @@ def test_a_damaged_settings_file_is_said_not_fatal(tmp_path: Path) -> None:
     damaged.write_text("[last\nrobot = 'R1'", encoding="utf-8")
     remembered, problem = load_remembered(damaged)
     assert remembered.filled() == {} and "not valid TOML" in problem
+
+
+# ---- the review list: verdicts, a robot filter, and crashed sessions named so ---------------
+
+
+def _write(folder: Path, robot: str, cycles: int, end: str | None, minute: int):
+    """A real session file through the real writer; ``end``: finish, interrupted or None
+    (the writer is returned still open, holding its lock, when ``end`` is "open")."""
+    from datetime import UTC, datetime
+
+    from station.analysis.capability import SpecLimits
+    from station.procedures import discover_procedures
+    from station.run import PortSetup, SessionSetup
+    from station.session.journal import SessionWriter
+
+    procedure = discover_procedures(use_env=False).get("repeatability")
+    port = PortSetup(url="loop://", protocol="mitutoyo", channel_map={"1": "x", "2": "y", "3": "z"})
+    header = SessionSetup(
+        procedure=procedure,
+        robot=robot,
+        operator="ana",
+        ports=(port,),
+        limits={c: SpecLimits(lsl=-0.001, usl=0.001, nominal=0.0) for c in "xyz"},
+    ).header_fields()
+    writer = SessionWriter.create(
+        folder, header, now=datetime(2026, 11, 23, 12, minute, tzinfo=UTC)
+    )
+    for cycle in range(1, cycles + 1):
+        channels = {
+            c: {"value": round(((cycle * 7 + i * 3) % 11 - 5) * 0.0001, 4), "unit": "in"}
+            for i, c in enumerate("xyz")
+        }
+        writer.append("reading", cycle=cycle, step="cycles", channels=channels)
+    if end == "open":
+        return writer
+    if end == "finish":
+        writer.append("finish", complete=True, accepted=cycles, rejected=[])
+    elif end == "interrupted":
+        writer.append("interrupted", reason="SIGHUP")
+    writer.close()
+    return None
+
+
+async def test_review_names_verdicts_filters_by_robot_and_calls_a_crash_a_crash(
+    tmp_path: Path, tui
+) -> None:
+    from textual.widgets import DataTable
+
+    from station.tui.screens.dialogs import TextPrompt
+    from station.tui.screens.review import ReviewScreen
+
+    _write(tmp_path, "R1", 30, "finish", 1)
+    _write(tmp_path, "R2", 5, None, 2)  # the writer went away without a word: a crash
+    _write(tmp_path, "R2", 4, "interrupted", 3)
+    live = _write(tmp_path, "R3", 3, "open", 4)  # a station is writing it right now
+    try:
+        app = _app(tmp_path)
+        async with app.run_test(size=(80, 24)) as pilot:
+            await pilot.press("v")
+            await tui.wait_until(pilot, lambda: isinstance(app.screen, ReviewScreen))
+            table = app.screen.query_one(DataTable)
+
+            def rows() -> list[tuple[str, str, str]]:
+                return [
+                    (str(r[0]), str(r[4]), str(r[5]))
+                    for r in (table.get_row_at(i) for i in range(table.row_count))
+                ]
+
+            await tui.wait_until(pilot, lambda: "…" not in [v for _, v, _ in rows()])
+            assert [c.label.plain for c in table.ordered_columns][4] == "verdict"
+            listed = rows()
+            assert listed[0][0] == "R1" and listed[0][1] in ("CAPABLE", "NOT CAPABLE")
+            assert ("R2", "—", "stopped without a word (crashed?)") in listed
+            assert ("R2", "—", "interrupted") in listed
+            assert ("R3", "—", "running now") in listed
+            # / shows one robot's sessions.
+            await pilot.press("slash")
+            await tui.wait_until(pilot, lambda: isinstance(app.screen, TextPrompt))
+            await pilot.press("r", "2", "enter")
+            await tui.wait_until(pilot, lambda: isinstance(app.screen, ReviewScreen))
+            await pilot.pause()
+            assert {robot for robot, _, _ in rows()} == {"R2"} and table.row_count == 2
+            assert "2 of 4 session(s), robot “r2”" in str(
+                app.screen.query_one("#review-folder", Static).render()
+            )
+    finally:
+        live.close()
