@@ -500,7 +500,9 @@ class StationApp(App[int]):
             self._replace_run_screen(DashboardScreen(live=True))
             return True
         if not wants_dashboard and not isinstance(screen, ChecklistScreen):
-            self._replace_run_screen(ChecklistScreen())
+            # From a capture back to the checklist: show what Space just recorded.
+            captured = state.last_cycle if isinstance(screen, DashboardScreen) else None
+            self._replace_run_screen(ChecklistScreen(just_captured=captured))
             return True
         return False
 

@@ -465,3 +465,103 @@ async def test_review_names_verdicts_filters_by_robot_and_calls_a_crash_a_crash(
             )
     finally:
         live.close()
+
+
+# ---- relative accuracy at 80×24 ---------------------------------------------------------------
+
+
+def _screen_text(app: StationApp) -> str:
+    """What the terminal shows, row by row (the screen's region of each widget, cropped)."""
+    rows = []
+    for strip in app.screen._compositor.render_strips():
+        rows.append("".join(segment.text for segment in strip))
+    return "\n".join(rows)
+
+
+def _whole_in(container, widget) -> bool:
+    return bool(widget.region) and container.region.contains_region(widget.region)
+
+
+async def test_relative_accuracy_at_80x24_pendant_fields_instruction_and_captured_error(
+    tmp_path: Path, tui
+) -> None:
+    from station.tui.instruments import DemoLab
+    from station.tui.screens.checklist import ChecklistScreen
+    from station.tui.screens.dashboard import DashboardScreen
+
+    lab = DemoLab(7, stroke_points=80)
+    try:
+        from station.tui.app import DemoPort
+        from station.tui.screens.setup import SetupScreen
+
+        fixture = lab.fixture("relative_accuracy")
+        port = DemoPort(
+            url=fixture.url,
+            protocol=fixture.protocol,
+            channel_map=fixture.channel_map,
+            procedure="relative_accuracy",
+            description=fixture.description,
+            trigger=fixture.trigger,
+            count=2,
+        )
+        app = StationApp(
+            StationConfig(
+                sessions_dir=tmp_path, sessions_reason="test folder", demo=port, demo_lab=lab
+            )
+        )
+        async with app.run_test(size=(80, 24)) as pilot:
+            await pilot.press("n")
+            await tui.wait_until(pilot, lambda: isinstance(app.screen, SetupScreen))
+            await pilot.pause()
+            await pilot.press("f2")
+            await tui.wait_until(pilot, lambda: app.runner is not None)
+            while app.runner.state().current.kind != "input":
+                before = app.runner.state().current.index
+                await tui.wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen))
+                await tui.wait_until(pilot, lambda: not app.screen.busy)
+                await pilot.press("enter")
+                await tui.wait_until(
+                    pilot, lambda before=before: app.runner.state().current.index != before
+                )
+            await tui.wait_until(pilot, lambda: len(app.screen.query("#step-inputs Input")) == 3)
+            await pilot.pause(0.2)
+            panel = app.screen.query_one("#step-panel")
+            shown = fixture.pendant(app.runner.state().current.placement)
+            # Typed by keyboard: each field in view as it is typed into.
+            for axis, value in zip("xyz", shown.pendant, strict=True):
+                field = app.screen.focused
+                assert field.id == f"input-{axis}", field
+                assert _whole_in(panel, field), f"pendant {axis} is typed blind"
+                await pilot.press(*str(value))
+                await pilot.press("enter")
+                await pilot.pause(0.1)
+            await tui.wait_until(pilot, lambda: app.runner.state().current.kind != "input")
+            # On to the capture: the whole instruction is on screen.
+            while app.runner.state().action.kind != "capture":
+                before = app.runner.state().current.index
+                await tui.wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen))
+                await tui.wait_until(pilot, lambda: not app.screen.busy)
+                await pilot.press("enter")
+                await tui.wait_until(
+                    pilot, lambda before=before: app.runner.state().current.index != before
+                )
+            await tui.wait_until(pilot, lambda: isinstance(app.screen, DashboardScreen))
+            await pilot.pause(0.3)
+            prompt = app.screen.query_one("#dash-prompt", Static)
+            words = str(prompt.render()).split()
+            on_screen = " ".join(_screen_text(app).split())
+            # The instruction's last words (where it says which key) are drawn, not cut.
+            assert " ".join(words[-4:]) in on_screen, (words, on_screen)
+            assert "Space" in " ".join(words)
+            # Space: the error just captured is shown before the checklist comes back.
+            await pilot.press("space")
+            await tui.wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen), 15)
+            await pilot.pause(0.2)
+            captured = str(app.screen.query_one("#step-captured", Static).render())
+            assert captured.startswith("Captured (set ") and " in" in captured, captured
+            assert all(f"{axis} " in captured for axis in "xyz"), captured
+            assert captured in _screen_text(app).replace("│", " ").replace("\n", " ") or all(
+                part in _screen_text(app) for part in captured.split("  ")
+            )
+    finally:
+        lab.stop()

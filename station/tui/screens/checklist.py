@@ -47,8 +47,11 @@ class ChecklistScreen(Screen[None]):
 
     app: StationApp
 
-    def __init__(self) -> None:
+    def __init__(self, just_captured: Any = None) -> None:
         super().__init__()
+        self._just_captured = just_captured
+        """The reading set the dashboard captured before handing over (a placement's error):
+        shown until the next step is done, so Space never jumps past what it recorded."""
         self._shown_step: tuple[int, str] | None = None
         self.busy = False
         """True while the runner carries out a step (keys for another step wait for it)."""
@@ -59,12 +62,15 @@ class ChecklistScreen(Screen[None]):
         with Horizontal(id="checklist"):
             with VerticalScroll(id="steps-box"):
                 yield StepList(id="steps")
-            with Vertical(id="step-panel"):
+            # Scrolls, so the fields of an input step (the pendant's X, Y, Z) are brought into
+            # view as they take the focus at 80×24.
+            with VerticalScroll(id="step-panel"):
                 yield Static(id="step-title")
                 yield Static(id="step-text")
                 # What Enter does and why a value was refused stay in view above the fields.
                 yield Static(id="step-action")
                 yield Static(id="step-message")
+                yield Static(id="step-captured")
                 yield Vertical(id="step-inputs")
         yield Footer()
 
@@ -73,6 +79,10 @@ class ChecklistScreen(Screen[None]):
         state = self.app.current_state()
         if state is not None:
             self.show_state(state)
+        if self._just_captured is not None:
+            self.query_one("#step-captured", Static).update(
+                captured_text(self._just_captured, self.app.session_header)
+            )
 
     def show_state(self, state: RunnerState) -> None:
         """Redraw from a runner snapshot (UI thread)."""
@@ -81,12 +91,22 @@ class ChecklistScreen(Screen[None]):
         current = state.current
         key = (current.index, current.id) if current is not None else None
         if key != self._shown_step:
+            if self._shown_step is not None:
+                self.query_one("#step-captured", Static).update("")
             self._shown_step = key
             self._show_step(current, state.placements, state.action)
         message = state.messages[-1] if state.messages else None
         if message is not None:
             style = {"error": "bold red", "warning": "yellow"}.get(message.level, "green")
-            self.query_one("#step-message", Static).update(shown(message.text, style=style))
+            if message.text == f"Session file {state.path}.":
+                # A path has no spaces to wrap at: folder and name on lines of their own,
+                # never broken mid-word (the title above names the file too).
+                text = shown("Session file in ", style=style)
+                text.append(shown_line(f"{state.path.parent}/", limit=None), style=style)
+                text.no_wrap, text.overflow = True, "ellipsis"
+            else:
+                text = shown(message.text, style=style)
+            self.query_one("#step-message", Static).update(text)
 
     def _show_step(
         self, view: StepView | None, placements: int | None = None, todo: Action | None = None
@@ -146,6 +166,8 @@ class ChecklistScreen(Screen[None]):
     def _focus_first_input(self) -> None:
         for widget in self.query("#step-inputs Input"):
             widget.focus()
+            # All the fields in view at once (at 80×24 they sit below the step's text).
+            self.query_one("#step-inputs").scroll_visible(animate=False)
             return
 
     # -- actions --------------------------------------------------------------------------
@@ -230,6 +252,22 @@ class ChecklistScreen(Screen[None]):
             ),
             callback=leave,
         )
+
+
+def captured_text(record: Any, header: dict[str, Any]) -> Text:
+    """``Captured (set 3): x +0.0003  y -0.0001  z +0.0002 in``: the set just recorded, at
+    the gauge's resolution."""
+    from station.text import format_value
+
+    resolution = header.get("resolution")
+    unit = str(header.get("unit") or "")
+    text = Text(f"Captured (set {record.cycle}): ", style="bold")
+    values = "  ".join(
+        f"{shown_line(channel, limit=20)} {format_value(value, resolution)}"
+        for channel, value in record.values.items()
+    )
+    text.append(f"{values} {unit}".rstrip(), style="bold")
+    return text
 
 
 def _run_title(state: RunnerState) -> Text:

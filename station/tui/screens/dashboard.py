@@ -88,7 +88,8 @@ class DashboardView:
         if state.placement is not None and state.placements:
             progress = f"placement {state.placement} of {state.placements}, {progress}"
         if ready:
-            prompt = "Every cycle asked for is captured. Press f to finish and see the verdict."
+            noun = counted.noun if counted is not None else "cycle"
+            prompt = f"Every {noun} asked for is captured. Press f to finish and see the verdict."
         if rejected:
             progress += f", {rejected} rejected"
         if state.status == "paused":

@@ -144,6 +144,7 @@ class SetupScreen(Screen[None]):
         self._testing = False
         self._initial: dict[str, str] = {}
         self._confirmed_limits: tuple[Any, ...] | None = None
+        self._refused_values: dict[str, str] = {}
         """The limits and resolution the operator confirmed despite an implausible ratio."""
 
     # -- layout ---------------------------------------------------------------------------
@@ -440,6 +441,10 @@ class SetupScreen(Screen[None]):
     def _clear_stale(self, field_id: str | None) -> None:
         if not field_id:
             return
+        # A change event can arrive after the refusal it preceded (the field and the screen
+        # have queues of their own): only a value other than the refused one is a correction.
+        if self._refused_values.get(field_id) == self._value(field_id):
+            return
         errors = self.query(f"#{field_id}-error")
         if errors and errors.first().has_class("-shown"):
             say(errors.first(), "")  # type: ignore[arg-type]
@@ -497,6 +502,8 @@ class SetupScreen(Screen[None]):
         """Put each sentence under its field, and take the operator to the first one."""
         for field_id, sentence in errors.items():
             self._say(field_id, sentence)
+            if self.query(f"#{field_id}"):
+                self._refused_values[field_id] = self._value(field_id)
         self._say("setup", f"{len(errors)} field(s) to correct above.")
         first_id = next(iter(errors))
         field = self.query_one(f"#{first_id}")
