@@ -78,3 +78,42 @@ def test_the_tui_exits_128_plus_the_signal(tmp_path: Path, signum: int, code: in
         assert pane.exit_status(timeout=20) == code
     finally:
         pane.close()
+
+
+def test_the_stations_own_terminal_is_refused_as_a_gauge_line(tmp_path: Path) -> None:
+    """Finding 10: a pseudo-terminal number reused by the operator's own window, typed or
+    recorded as the gauge port, was opened; the poll request "1\\r" was drawn at the top-left
+    and the reader thread ate keys. Now it is refused with a sentence."""
+    pane = Pane([sys.executable, "-m", "station", "--sessions", str(tmp_path)], tmp_path)
+    try:
+        pane.wait_for("New session", timeout=30)
+        tty = _tmux("display-message", "-p", "-t", pane.name, "#{pane_tty}").strip()
+        _tmux("send-keys", "-t", pane.name, "n")
+        pane.wait_for("Tab / Shift+Tab", timeout=30)
+        _tmux("send-keys", "-t", pane.name, "R1")
+        for _ in range(10):  # robot → ... → the port field
+            _tmux("send-keys", "-t", pane.name, "Tab")
+        pane.wait_for("Port", timeout=10)
+        _tmux("send-keys", "-t", pane.name, "-l", tty)
+        time.sleep(0.5)
+        _tmux("send-keys", "-t", pane.name, "F3")
+        screen = pane.wait_for("own terminal", timeout=20)
+        assert "Connected to" not in screen
+    finally:
+        pane.close()
+
+
+def test_station_read_refuses_its_own_terminal(tmp_path: Path) -> None:
+    """The same guard at the transport: every command that opens a gauge line refuses the
+    terminal it runs in (and so does the reader's reconnect)."""
+    command = (
+        f'{shlex.quote(sys.executable)} -m station read --port "$(tty)" --protocol mitutoyo '
+        "--count 1; echo EXIT=$?"
+    )
+    pane = Pane(["sh", "-c", command], tmp_path)
+    try:
+        screen = pane.wait_for("EXIT=", timeout=30)
+        joined = screen.replace("\n", "").replace(" ", "")  # tmux wraps at 80 mid-word
+        assert "EXIT=2" in screen and "isthisstation'sownterminal" in joined, screen
+    finally:
+        pane.close()

@@ -534,11 +534,17 @@ class SetupScreen(Screen[None]):
     def read_ports(self, errors: dict[str, str]) -> tuple[Any, ...]:
         """The instrument line as the runner's ``PortSetup``; faults go into ``errors``."""
         from station.instruments.protocols import get_protocol
+        from station.instruments.transport import refuse_own_terminal, url_scheme
         from station.run import PortSetup
 
         url = self._value("port")
         if not url:
             errors["port"] = "Name the port of the indicators (or pick a detected one above)."
+        elif url_scheme(url) is None:
+            try:
+                refuse_own_terminal(url)
+            except StationError as error:
+                errors["port"] = explained(error)
         try:
             protocol = get_protocol(self._value("protocol"))
         except StationError as error:
