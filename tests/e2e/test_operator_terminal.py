@@ -61,23 +61,85 @@ class Pane:
             if dead == "1" and status:
                 return int(status)
             time.sleep(0.1)
-        pytest.fail(f"station did not exit within {timeout} s:\n{self.screen()}")
+        fields = _tmux(
+            "display-message",
+            "-p",
+            "-t",
+            self.name,
+            "dead=#{pane_dead} status=#{pane_dead_status} signal=#{pane_dead_signal}",
+        )
+        pytest.fail(f"station did not exit within {timeout} s ({fields}):\n{self.screen()}")
 
     def close(self) -> None:
         subprocess.run(["tmux", "kill-session", "-t", self.name], capture_output=True, check=False)
+
+
+class PtyProcess:
+    """``station`` on a real pseudo-terminal of 80×24 (not tmux: its pane can lose the exit
+    status), its output drained on a thread so it never blocks on a full terminal; ``{tty}``
+    in an argument is the terminal's own name."""
+
+    def __init__(self, args: list[str], cwd: Path, stderr=None) -> None:
+        import fcntl
+        import struct
+        import termios
+        import threading
+
+        master, slave = os.openpty()
+        fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 80, 0, 0))
+        self.tty = os.ttyname(slave)
+        env = dict(os.environ, TERM="xterm-256color")
+        self.process = subprocess.Popen(
+            [arg.replace("{tty}", self.tty) for arg in args],
+            stdin=slave,
+            stdout=slave,
+            stderr=slave if stderr is None else stderr,
+            cwd=cwd,
+            env=env,
+            start_new_session=True,
+        )
+        os.close(slave)
+        self._master = master
+        self.output = bytearray()
+        self._reader = threading.Thread(target=self._drain, daemon=True)
+        self._reader.start()
+
+    def _drain(self) -> None:
+        while True:
+            try:
+                chunk = os.read(self._master, 65536)
+            except OSError:
+                return
+            if not chunk:
+                return
+            self.output.extend(chunk)
+
+    def wait_for(self, text: str, timeout: float) -> None:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if text.encode() in self.output:
+                return
+            time.sleep(0.05)
+        pytest.fail(f"{text!r} was not drawn within {timeout} s")
+
+    def close(self) -> None:
+        if self.process.poll() is None:
+            self.process.kill()
+            self.process.wait(10)
+        os.close(self._master)
 
 
 @pytest.mark.parametrize(
     ("signum", "code"), [(signal.SIGHUP, 129), (signal.SIGTERM, 143)], ids=["SIGHUP", "SIGTERM"]
 )
 def test_the_tui_exits_128_plus_the_signal(tmp_path: Path, signum: int, code: int) -> None:
-    pane = Pane([sys.executable, "-m", "station", "--sessions", str(tmp_path)], tmp_path)
+    station = PtyProcess([sys.executable, "-m", "station", "--sessions", str(tmp_path)], tmp_path)
     try:
-        pane.wait_for("New session", timeout=30)
-        os.kill(pane.pid, signum)
-        assert pane.exit_status(timeout=20) == code
+        station.wait_for("New session", timeout=30)
+        station.process.send_signal(signum)
+        assert station.process.wait(20) == code
     finally:
-        pane.close()
+        station.close()
 
 
 def test_the_stations_own_terminal_is_refused_as_a_gauge_line(tmp_path: Path) -> None:
@@ -106,14 +168,13 @@ def test_the_stations_own_terminal_is_refused_as_a_gauge_line(tmp_path: Path) ->
 def test_station_read_refuses_its_own_terminal(tmp_path: Path) -> None:
     """The same guard at the transport: every command that opens a gauge line refuses the
     terminal it runs in (and so does the reader's reconnect)."""
-    command = (
-        f'{shlex.quote(sys.executable)} -m station read --port "$(tty)" --protocol mitutoyo '
-        "--count 1; echo EXIT=$?"
-    )
-    pane = Pane(["sh", "-c", command], tmp_path)
-    try:
-        screen = pane.wait_for("EXIT=", timeout=30)
-        joined = screen.replace("\n", "").replace(" ", "")  # tmux wraps at 80 mid-word
-        assert "EXIT=2" in screen and "isthisstation'sownterminal" in joined, screen
-    finally:
-        pane.close()
+    errors = tmp_path / "stderr.txt"
+    command = [sys.executable, "-m", "station", "read", "--port", "{tty}", "--protocol"]
+    with errors.open("wb") as sink:
+        read = PtyProcess([*command, "mitutoyo", "--count", "1"], tmp_path, stderr=sink)
+        try:
+            code = read.process.wait(30)
+        finally:
+            read.close()
+    assert code == 2, errors.read_text()
+    assert "is this station's own terminal, not a gauge line" in errors.read_text()
