@@ -128,17 +128,23 @@ class DemoLab:
     """The demo's simulators, one per procedure, each started the first time it is asked for
     (so the set-up's procedure picker switches the simulated set-up with the procedure)."""
 
-    def __init__(self, seed: int = 1990, *, stroke_points: int = 400) -> None:
+    def __init__(
+        self, seed: int = 1990, *, stroke_points: int = 400, link_prefix: str | None = None
+    ) -> None:
         self.seed = seed
         self.stroke_points = stroke_points
+        self.link_prefix = link_prefix
+        """When set, each simulator's port is also a link named ``<prefix>-<procedure>`` (a
+        name that does not change from run to run, for the screen snapshots)."""
         self._fixtures: dict[str, DemoFixture] = {}
 
     def fixture(self, procedure: str) -> DemoFixture:
         """The running simulator for ``procedure`` (a fixture model for unknown ones)."""
         key = procedure if procedure in DEMO_PROCEDURES else "repeatability"
         if key not in self._fixtures:
+            link = f"{self.link_prefix}-{key}" if self.link_prefix else None
             self._fixtures[key] = start_demo_fixture(
-                self.seed, procedure=key, stroke_points=self.stroke_points
+                self.seed, procedure=key, stroke_points=self.stroke_points, link=link
             )
         return self._fixtures[key]
 

@@ -11,7 +11,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from rich.text import Text
-from textual import work
+from textual import events, work
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical, VerticalScroll
@@ -21,6 +21,7 @@ from textual.widgets import Footer, Input, Label, Static
 from station.errors import StationError
 from station.tui.remedies import explained
 from station.tui.text import shown, shown_line
+from station.tui.widgets.fields import mark_focused_row
 from station.tui.widgets.step_list import StepList
 
 if TYPE_CHECKING:
@@ -162,6 +163,10 @@ class ChecklistScreen(Screen[None]):
             return None
         unit = str(self.app.session_header.get("unit") or "in")
         return str(placement.pendant_text(unit))
+
+    def on_descendant_focus(self, event: events.DescendantFocus) -> None:
+        """Mark the focused field's row (its label in reverse video)."""
+        mark_focused_row(self, event.widget)
 
     def _focus_first_input(self) -> None:
         for widget in self.query("#step-inputs Input"):

@@ -110,20 +110,30 @@ UNDEFINED when there are no limits or too few readings.
 """
 
 
+APP_KEYS = ("quit_station", "command_palette")
+"""The app's own keys listed beside a screen's (Textual's built-in ones are left out)."""
+
+
 def screen_keys(screen: Screen[object]) -> list[tuple[str, str]]:
-    """The keys ``screen`` answers now (its own, its focused widget's and the app's), each with
-    what it does, in the order the footer shows them; keys without a description are left out
-    (they repeat one that has it, e.g. ``x`` beside Tab for the axis)."""
+    """The keys ``screen`` answers now: its own first, in the footer's order, then Ctrl+C;
+    a list's or a field's own movement keys are left out (they are the same everywhere), as
+    are keys without a description (they repeat one that has it, e.g. ``x`` beside Tab)."""
     app = screen.app
-    keys: list[tuple[str, str]] = []
+    own: list[tuple[str, str]] = []
+    general: list[tuple[str, str]] = []
     seen: set[str] = set()
     for active in screen.active_bindings.values():
         binding = active.binding
         if not binding.description or binding.action in seen or not active.enabled:
             continue
+        if active.node is screen:
+            own.append((app.get_key_display(binding), binding.description))
+        elif active.node is app and binding.action in APP_KEYS:
+            general.append((app.get_key_display(binding), binding.description))
+        else:
+            continue
         seen.add(binding.action)
-        keys.append((app.get_key_display(binding), binding.description))
-    return keys
+    return own + general
 
 
 class HelpScreen(ModalScreen[None]):
@@ -145,7 +155,8 @@ class HelpScreen(ModalScreen[None]):
                 for key, description in keys:
                     text.append(f"  {key:<12}", style="bold")
                     text.append(f" {description}\n")
-                text.append("  Ctrl+P       every action of this screen by name\n")
+                if not any(description == "palette" for _, description in keys):
+                    text.append("  ^p           every action of this screen by name\n")
                 yield Static(text, id="help-keys")
             yield Static(HELP_TEXT)
         yield Footer()

@@ -60,12 +60,13 @@ class ReviewScreen(Screen[None]):
         folder = self.app.config.sessions_dir
         self._all = list(list_sessions(folder))
         table = self.query_one(DataTable)
+        # A finished session's verdict and an unfinished one's state share a column: one of
+        # them is all a row has, and both fit 80 columns beside the robot and the date.
         table.add_column("robot", key="robot")
         table.add_column("created (UTC)", key="created")
+        table.add_column("verdict / state", key="verdict")
         table.add_column("procedure", key="procedure")
         table.add_column("cycles", key="cycles")
-        table.add_column("verdict", key="verdict", width=11)
-        table.add_column("status", key="status")
         self._fill()
         table.focus()
         finished = [s.path for s in self._all if not s.error and s.status == "finished"]
@@ -74,7 +75,6 @@ class ReviewScreen(Screen[None]):
 
     def _fill(self) -> None:
         """The rows of the sessions the robot filter lets through."""
-        from station.session.store import status_words
 
         table = self.query_one(DataTable)
         table.clear()
@@ -85,13 +85,7 @@ class ReviewScreen(Screen[None]):
         for index, summary in enumerate(self._sessions):
             if summary.error:
                 table.add_row(
-                    shown(summary.path.name, limit=120),
-                    "",
-                    "",
-                    "",
-                    "",
-                    "unreadable",
-                    key=str(index),
+                    shown(summary.path.name, limit=120), "", "unreadable", "", "", key=str(index)
                 )
                 continue
             cycles = f"{summary.cycles}"
@@ -102,10 +96,9 @@ class ReviewScreen(Screen[None]):
             table.add_row(
                 shown(summary.robot, limit=60),
                 shown(summary.created[:16].replace("T", " ")),
+                self._verdict_cell(summary),
                 shown(summary.procedure, limit=60),
                 cycles,
-                self._verdict_cell(summary),
-                shown(status_words(summary)),
                 key=str(index),
             )
         folder = self.app.config.sessions_dir
@@ -120,10 +113,11 @@ class ReviewScreen(Screen[None]):
         self.query_one("#review-folder", Static).update(shown(note, style="dim"))
 
     def _verdict_cell(self, summary: Any) -> Text:
+        from station.session.store import status_words
         from station.tui.widgets.figures import VERDICT_STYLES
 
         if summary.error or summary.status != "finished":
-            return Text("—")
+            return shown(status_words(summary))
         word = self._verdicts.get(summary.path)
         if word is None:
             return Text("…")
