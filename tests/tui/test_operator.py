@@ -567,3 +567,24 @@ async def test_relative_accuracy_at_80x24_pendant_fields_instruction_and_capture
             )
     finally:
         lab.stop()
+
+
+async def test_no_readings_yet_only_with_none(tmp_path: Path, fixture_pty, tui) -> None:
+    """Finding 9: the chart said "no readings yet" beside a table with one reading."""
+    from station.tui.widgets.control_chart import ControlChartView
+
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await tui.open_setup(pilot, "R9", fixture_pty.url)
+        await pilot.press("f2")
+        await tui.walk_checklist(pilot)
+        await pilot.pause(0.3)
+        chart = app.screen.query_one(ControlChartView)
+        assert "no readings yet" in str(chart.render())
+        await tui.capture_one(pilot)
+        await pilot.pause(0.3)
+        drawn = str(chart.render())
+        assert "no readings yet" not in drawn and "2 readings (have 1)" in drawn, drawn
+        await tui.capture_one(pilot)
+        await pilot.pause(0.3)
+        assert "have 1" not in str(chart.render())

@@ -230,6 +230,21 @@ def test_relative_accuracy_pendant_step(snap_compare, lab, tui) -> None:
         await _start(pilot, tui)
         await _until_action(pilot, tui, "input")
         await tui.wait_until(pilot, lambda: len(pilot.app.screen.query("#step-inputs Input")) == 3)
+        screen = pilot.app.screen
+        for field in screen.query("#step-inputs Input"):
+            field.cursor_blink = False  # a blinking cursor is not the same picture twice
+        # Focused, its row marked, and the fields scrolled into view (however slow the machine).
+        await tui.wait_until(
+            pilot,
+            lambda: (
+                screen.focused is not None
+                and screen.focused.id == "input-x"
+                and screen.focused.parent.has_class("-has-focus")
+            ),
+        )
+        panel = screen.query_one("#step-panel")
+        last = screen.query("#step-inputs Input").last()
+        await tui.wait_until(pilot, lambda: panel.region.contains_region(last.region))
         await pilot.pause(0.3)
 
     app = _demo_app(lab, "relative_accuracy", 2)
