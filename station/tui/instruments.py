@@ -177,12 +177,22 @@ def gauge_set(ports: Sequence[Any], trigger: str, **options: Any) -> Any:
 
 
 def test_connection(
-    ports: Sequence[Any], trigger: str, captures: int = TEST_CAPTURES, timeout: float = 3.0
+    ports: Sequence[Any],
+    trigger: str,
+    captures: int = TEST_CAPTURES,
+    timeout: float = 3.0,
+    *,
+    resolution: float | None = None,
+    unit: str = "",
 ) -> Iterator[list[str]]:
-    """Open the line, take a few reading sets and yield the lines to show after each one.
+    """Open the line, take a few reading sets and yield the lines to show after each one: the
+    values at the gauge's ``resolution`` (as the dashboard shows them) with their unit (the
+    frame's own, else ``unit``).
 
     Nothing is recorded. Raises StationError when the port cannot be opened or stays silent.
     """
+    from station.text import format_value
+
     gauges = gauge_set(ports, trigger if trigger != "push" else "poll")
     gauges.start()
     try:
@@ -197,8 +207,19 @@ def test_connection(
         for number in range(1, captures + 1):
             result = gauges.capture(timeout)
             values = "  ".join(
-                f"{channel}={reading.value:+.5f}" for channel, reading in result.readings.items()
+                f"{channel}={format_value(reading.value, resolution)}"
+                for channel, reading in result.readings.items()
             )
+            # The frame's own unit when it states one, else the set-up's (``unit`` of a
+            # reading without one is only the reader's default).
+            units = {
+                str(r.frame_unit)
+                for r in result.readings.values()
+                if getattr(r, "frame_unit", None)
+            }
+            shown_unit = units.pop() if len(units) == 1 else ("" if units else unit)
+            if values and shown_unit:
+                values += f" {shown_unit}"
             note = f"  ({result.message})" if result.message else ""
             lines = [*lines, f"  {number}: {values or 'no reading'}{note}"]
             yield lines

@@ -588,3 +588,22 @@ async def test_no_readings_yet_only_with_none(tmp_path: Path, fixture_pty, tui) 
         await tui.capture_one(pilot)
         await pilot.pause(0.3)
         assert "have 1" not in str(chart.render())
+
+
+async def test_test_connection_reads_at_the_resolution_with_the_unit(
+    tmp_path: Path, fixture_pty, tui
+) -> None:
+    """Finding 9: the live readings of F3 showed five decimals and no unit."""
+    import re
+
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await tui.open_setup(pilot, "R8", fixture_pty.url)
+        await pilot.press("f3")
+        output = app.screen.query_one("#test-output", Static)
+        await tui.wait_until(pilot, lambda: "The line works" in str(output.render()), 20)
+        lines = [line for line in str(output.render()).splitlines() if "x=" in line]
+        assert lines
+        for line in lines:
+            # 0.0001 in gauge: four decimals, as the gauge shows them, and the unit.
+            assert re.search(r"x=[+-]\d\.\d{4}  y=[+-]\d\.\d{4}  z=[+-]\d\.\d{4} in$", line), line

@@ -715,15 +715,22 @@ class SetupScreen(Screen[None]):
         self.query_one("#test-output", Static).update(
             shown(f"Opening {ports[0].url} ...", style="yellow")
         )
-        self._test_connection(ports, self._value("trigger"))
+        try:
+            resolution: float | None = float(self._value("resolution"))
+        except ValueError:
+            resolution = None
+        self._test_connection(ports, self._value("trigger"), resolution, self._value("unit"))
 
     @work(thread=True, group="test-connection", exclusive=True, exit_on_error=False)
-    def _test_connection(self, ports: tuple[Any, ...], trigger: str) -> None:
-        """Thread worker: a few captures through the real reader, posted line by line."""
+    def _test_connection(
+        self, ports: tuple[Any, ...], trigger: str, resolution: float | None, unit: str
+    ) -> None:
+        """Thread worker: a few captures through the real reader, posted line by line (values
+        at the form's resolution, with the unit)."""
         from station.tui.instruments import test_connection
 
         try:
-            for lines in test_connection(ports, trigger):
+            for lines in test_connection(ports, trigger, resolution=resolution, unit=unit):
                 self.post_message(ConnectionTested(lines=lines))
             self.post_message(ConnectionTested(done=True))
         except StationError as error:
