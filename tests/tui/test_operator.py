@@ -607,3 +607,27 @@ async def test_test_connection_reads_at_the_resolution_with_the_unit(
         for line in lines:
             # 0.0001 in gauge: four decimals, as the gauge shows them, and the unit.
             assert re.search(r"x=[+-]\d\.\d{4}  y=[+-]\d\.\d{4}  z=[+-]\d\.\d{4} in$", line), line
+
+
+async def test_exporting_from_the_summary_says_so_without_covering_it(
+    tmp_path: Path, monkeypatch, tui
+) -> None:
+    """Finding 9: the export toasts covered the summary's text."""
+    import shutil
+
+    from textual.widgets._toast import Toast
+
+    from station.tui.screens.summary import SummaryScreen, SummaryView
+
+    saved = SNAPSHOT_SESSIONS / "sessions" / "2026-11-23T175031Z_R1_repeatability.jsonl"
+    shutil.copy(saved, tmp_path / saved.name)
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        app.push_screen(SummaryScreen(SummaryView.from_file(tmp_path / saved.name)))
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, SummaryScreen))
+        await pilot.press("e")
+        await pilot.pause(0.3)
+        message = app.screen.query_one("#summary-message", Static)
+        assert "report exported to" in str(message.render())
+        assert message.region and message.region.y < 23  # above the footer, in view
+        assert not list(app.query(Toast)), "a toast covers the summary"

@@ -261,7 +261,18 @@ class SummaryScreen(Screen[None]):
             yield report
             yield Static(hints_text(self.view), id="summary-hints")
             yield Static(file_text(self.view, self.exported), id="summary-file")
+        # Exports and refusals are said on this line, not in toasts over the verdict.
+        yield Static("", id="summary-message")
         yield Footer()
+
+    def notify(  # type: ignore[override]
+        self, message: str, *, severity: str = "information", markup: bool = True, **_: Any
+    ) -> None:
+        """Say ``message`` on the summary's own message line (a toast would cover the
+        summary's text); errors in bold, as words, not only a colour."""
+        style = {"error": "bold red", "warning": "bold yellow"}.get(severity, "green")
+        prefix = {"error": "Error: ", "warning": "Warning: "}.get(severity, "")
+        self.query_one("#summary-message", Static).update(shown(prefix + message, style=style))
 
     def _refresh_file(self) -> None:
         self.query_one("#summary-file", Static).update(file_text(self.view, self.exported))
