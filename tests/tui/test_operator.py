@@ -631,3 +631,23 @@ async def test_exporting_from_the_summary_says_so_without_covering_it(
         assert "report exported to" in str(message.render())
         assert message.region and message.region.y < 23  # above the footer, in view
         assert not list(app.query(Toast)), "a toast covers the summary"
+
+
+async def test_the_help_is_wrapped_for_80_columns(tmp_path: Path) -> None:
+    """Finding 9: the help broke mid-sentence at 80 columns (its lines were longer than the
+    dialog, so each was re-wrapped where it happened to end). Every line of it is drawn whole
+    on one row of the 80×24 screen."""
+    import re
+
+    from station.tui.screens.dialogs import HELP_TEXT, HelpScreen
+
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("question_mark")
+        await pilot.pause(0.3)
+        assert isinstance(app.screen, HelpScreen)
+        body = app.screen.query_one(".dialog")
+        width = body.scrollable_content_region.width
+        for line in HELP_TEXT.splitlines():
+            visible = re.sub(r"\[/?b\]", "", line)
+            assert len(visible) <= width, f"re-wrapped at {width}: {visible!r}"

@@ -85,28 +85,36 @@ class QuitQuestion(ConfirmScreen):
 
 
 HELP_TEXT = """\
-[b]Home[/b]  ↑ ↓ choose · Enter open · n new session · r resume · v review · q quit
+[b]Home[/b]  ↑ ↓ choose · Enter open · n new session · r resume
+  v review · q quit
 
-[b]Set-up[/b]  Tab / Shift+Tab move between fields · F3 test connection · F2 start
-  Limits: ±0.001 (a tolerance about nominal 0) or -0.001:0.001 (LSL:USL); one side may be empty.
-  Port: pick a detected port or type /dev/ttyUSB0, /dev/pts/N, rfc2217://host:port, socket://host:port.
+[b]Set-up[/b]  Tab / Shift+Tab move between fields · F3 test connection
+  F2 start. Limits: ±0.001 (a tolerance about nominal 0) or
+  -0.001:0.001 (LSL:USL); one side may be empty. Port: pick a detected
+  port or type /dev/ttyUSB0, rfc2217://host:port or socket://host:port.
 
-[b]Checklist[/b]  Enter confirms the step (zeroes at a zero step, saves typed values at an
-  input step) · n note · q leave (the session stays resumable)
+[b]Checklist[/b]  Enter confirms the step (zeroes at a zero step, saves
+  typed values at an input step) · n note · q leave (resumable)
 
-[b]Capture[/b]  Space capture a cycle · r reject the last cycle (asks why; nothing is deleted)
-  n note · p pause / continue · f finish · x y z or Tab choose the axis in the charts
-  q leave (the session stays resumable)
+[b]Capture[/b]  Space capture a cycle · r reject the last cycle (asks
+  why; nothing is deleted) · n note · p pause / continue · f finish
+  x y z or Tab choose the axis · q leave (resumable)
 
-[b]Strokes[/b]  (linearity) the strokes stream as the robot shuttles A↔B · e end the stroke
-  now (streaming stops; Space streams again) · f finish · h v or Tab choose the indicator
+[b]Strokes[/b]  (linearity) the strokes stream as the robot shuttles
+  A↔B · e end the stroke now (Space streams again) · f finish
+  h v or Tab choose the indicator
 
-[b]Summary[/b]  e export the text report · c export CSV · d charts · h home · q quit
+[b]Summary[/b]  e export the text report · c export CSV · d charts
+  h home · q quit
 
-Every reading is on disk (fsynced) before it is shown as captured. If the link drops, the
-session is marked interrupted; run `station` again and choose Resume.
-Verdicts: CAPABLE when Cpk ≥ the threshold (1.00 by default), NOT CAPABLE otherwise,
-UNDEFINED when there are no limits or too few readings.
+[b]Everywhere[/b]  ? the keys of the screen · Ctrl+P every action by
+  name · Ctrl+C quit (inside a dialog it asks first)
+
+Every reading is on disk (fsynced) before it is shown as captured.
+If the link drops, the session is marked interrupted; run `station`
+again and choose Resume. Verdicts: CAPABLE when Cpk ≥ the threshold
+(1.00 by default), NOT CAPABLE otherwise, UNDEFINED when there are no
+limits or too few readings.
 """
 
 
