@@ -651,3 +651,37 @@ async def test_the_help_is_wrapped_for_80_columns(tmp_path: Path) -> None:
         for line in HELP_TEXT.splitlines():
             visible = re.sub(r"\[/?b\]", "", line)
             assert len(visible) <= width, f"re-wrapped at {width}: {visible!r}"
+
+
+async def test_linearity_one_sided_limits_are_explained_on_screen(
+    tmp_path: Path, monkeypatch, tui
+) -> None:
+    """Finding 9: the straightness judged one-sided against a 0.002 zone was explained only
+    in the procedure's TOML file."""
+    from textual.widgets import Select
+
+    from station.tui.screens.setup import SetupScreen
+    from station.tui.screens.summary import SummaryScreen, SummaryView
+
+    saved = SNAPSHOT_SESSIONS / "sessions" / "2026-11-29T211526Z_demo-robot_linearity.jsonl"
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("n")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, SetupScreen))
+        await pilot.pause()
+        app.screen.query_one("#procedure", Select).value = "linearity"
+        await tui.wait_until(
+            pilot, lambda: isinstance(app.screen, SetupScreen) and app.screen.is_mounted
+        )
+        await pilot.pause(0.3)
+        hints = " ".join(str(s.render()) for s in app.screen.query(".field-hint"))
+        assert "judged one-sided" in hints and "0.002" in hints
+        app.push_screen(SummaryScreen(SummaryView.from_file(saved), reviewing=True))
+        await tui.wait_until(
+            pilot,
+            lambda: (
+                isinstance(app.screen, SummaryScreen) and bool(app.screen.query("#summary-verdict"))
+            ),
+        )
+        verdict = str(app.screen.query_one("#summary-verdict", Static).render())
+        assert "one-sided: upper limit 0.00200 in only" in verdict, verdict

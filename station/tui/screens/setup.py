@@ -48,6 +48,11 @@ DEMO_TRIAL_MINIMUM = 2
 """The fewest cycles, placements or strokes a demo's trial run may ask for."""
 KEPT_ON_PROCEDURE_CHANGE = ("robot", "operator", "port", "protocol", "map", "trigger")
 LIMIT_HELP = "±0.001 or LSL:USL, e.g. -0.001:0.0015 (one side may be empty)"
+STROKE_LIMITS_HELP = (
+    "Strokes: the limits about the bar's line make a straightness tolerance of USL − LSL "
+    "(±0.001 → 0.002); each stroke's straightness (never below 0) is judged one-sided "
+    "against it: Cpk = (tolerance − X̄)/3σ, Cp is not defined."
+)
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 
 
@@ -263,6 +268,10 @@ class SetupScreen(Screen[None]):
                     f"limits-{channel}",
                 )
             yield Static(LIMIT_HELP, classes="field-hint")
+            if any(step.kind == "stroke" for step in procedure.steps):
+                # Streamed strokes are judged by their straightness, not by these limits
+                # directly: say how, here, and not only in the procedure file.
+                yield Static(STROKE_LIMITS_HELP, classes="field-hint")
             yield from _field(
                 count.label,
                 Input(

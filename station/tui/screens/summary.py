@@ -132,6 +132,24 @@ def report_text(view: SummaryView) -> Text:
     return shown("\n".join(view.report.lines), no_wrap=True, overflow="crop")
 
 
+def one_sided_sentence(capability: Any, decimals: int, unit: str) -> str:
+    """Why Cp shows "—" beside a Cpk: a limit on one side only (the straightness of a stroke,
+    never below 0, against its tolerance) is judged one-sided; "" for two-sided limits."""
+    lsl = getattr(capability, "lsl", None)
+    usl = getattr(capability, "usl", None)
+    if (lsl is None) == (usl is None):
+        return ""
+    if usl is not None:
+        return (
+            f"one-sided: upper limit {number(usl, decimals, signed=False)} {unit} only; "
+            "Cpk = (USL − X̄)/3σ, Cp needs two limits."
+        )
+    return (
+        f"one-sided: lower limit {number(lsl, decimals)} {unit} only; "
+        "Cpk = (X̄ − LSL)/3σ, Cp needs two limits."
+    )
+
+
 def verdict_text(view: SummaryView) -> Text:
     """The verdict block: overall, then one line per axis with Cp, Cpk and the reason."""
     analysis = view.analysis
@@ -157,6 +175,9 @@ def verdict_text(view: SummaryView) -> Text:
         )
         if word == "UNDEFINED" and capability.message:
             text.append(f"      {shown_line(capability.message, limit=None)}\n", style="yellow")
+        one_sided = one_sided_sentence(capability, view.decimals, view.unit)
+        if one_sided:
+            text.append(f"      {one_sided}\n")
     return text
 
 
