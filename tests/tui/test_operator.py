@@ -29,6 +29,10 @@ async def test_ctrl_c_in_the_note_dialog_asks_and_keeps_the_typed_note(
         await tui.open_setup(pilot, "R6", fixture_pty.url)
         await pilot.press("f2")
         await tui.wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen))
+        await pilot.pause(0.2)
+        # Finding 9: the session path is not broken mid-word ("...js / onl."): one line.
+        where = app.screen.query_one("#step-message", Static)
+        assert str(where.render()).startswith("Session file in ") and where.region.height == 1
         await pilot.press("n")
         await tui.wait_until(pilot, lambda: isinstance(app.screen, TextPrompt))
         await pilot.press(*"dial 2 loose")

@@ -99,15 +99,18 @@ class ChecklistScreen(Screen[None]):
         message = state.messages[-1] if state.messages else None
         if message is not None:
             style = {"error": "bold red", "warning": "yellow"}.get(message.level, "green")
-            if message.text == f"Session file {state.path}.":
-                # A path has no spaces to wrap at: folder and name on lines of their own,
-                # never broken mid-word (the title above names the file too).
+            line = self.query_one("#step-message", Static)
+            is_path = message.text == f"Session file {state.path}."
+            if is_path:
+                # A path has no spaces to wrap at: the folder on one line, cut with an
+                # ellipsis rather than broken mid-word (the title above names the file).
                 text = shown("Session file in ", style=style)
                 text.append(shown_line(f"{state.path.parent}/", limit=None), style=style)
-                text.no_wrap, text.overflow = True, "ellipsis"
             else:
                 text = shown(message.text, style=style)
-            self.query_one("#step-message", Static).update(text)
+            line.styles.text_wrap = "nowrap" if is_path else "wrap"
+            line.styles.text_overflow = "ellipsis" if is_path else "fold"
+            line.update(text)
 
     def _show_step(
         self, view: StepView | None, placements: int | None = None, todo: Action | None = None
