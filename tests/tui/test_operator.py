@@ -689,3 +689,34 @@ async def test_linearity_one_sided_limits_are_explained_on_screen(
         )
         verdict = str(app.screen.query_one("#summary-verdict", Static).render())
         assert "one-sided: upper limit 0.00200 in only" in verdict, verdict
+
+
+async def test_long_alarm_texts_open_in_full(tmp_path: Path, fixture_pty, tui) -> None:
+    """The alarm log cuts each alarm to one line; ``m`` shows them in full."""
+    from station.tui.screens.dialogs import FullTextScreen
+    from station.tui.widgets.alarm_log import AlarmLog
+
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await tui.open_setup(pilot, "R1", fixture_pty.url)
+        await pilot.press("f2")
+        await tui.walk_checklist(pilot)
+        log = app.screen.query_one(AlarmLog)
+        for _ in range(25):
+            await tui.capture_one(pilot)
+            if "⚠" in str(log.render()):
+                break
+        await pilot.pause(0.3)
+        drawn = _screen_text(app)
+        alarm_row = next(row for row in drawn.splitlines() if "⚠" in row)
+        assert alarm_row.rstrip().endswith("…"), alarm_row  # cut on the dashboard
+        await pilot.press("m")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, FullTextScreen))
+        await pilot.pause(0.2)
+        full = str(app.screen.query_one("#full-text", Static).render())
+        cut = alarm_row.strip().lstrip("⚠ ").rstrip("…").strip()
+        line = next(line for line in full.split("\n\n") if line.startswith(cut))
+        assert len(line) > len(cut) and not line.endswith("…")
+        # Drawn whole, wrapped, on the 80×24 screen.
+        assert " ".join(line.split()[-3:]) in " ".join(_screen_text(app).split())
+        await pilot.press("escape")

@@ -172,3 +172,30 @@ class HelpScreen(ModalScreen[None]):
     def action_close(self) -> None:
         """Back to the screen underneath."""
         self.dismiss(None)
+
+
+class FullTextScreen(ModalScreen[None]):
+    """A long text in full (the alarm log and the message line cut theirs to one line each):
+    wrapped, scrollable, closed with Escape."""
+
+    BINDINGS = [
+        Binding("escape", "close", "Close"),
+        Binding("q", "close", "Close", show=False),
+    ]
+
+    def __init__(self, title: str, lines: list[str]) -> None:
+        super().__init__()
+        self._title = title
+        self._lines = lines
+
+    def compose(self) -> ComposeResult:
+        """The title and each line in full, in a scrolling box."""
+        with VerticalScroll(classes="dialog help"):
+            yield Static(shown(self._title, style="bold"), classes="dialog-title")
+            body = "\n\n".join(self._lines) if self._lines else "Nothing to show yet."
+            yield Static(shown(body), id="full-text")
+        yield Footer()
+
+    def action_close(self) -> None:
+        """Back to the screen underneath."""
+        self.dismiss(None)
