@@ -16,9 +16,11 @@ import pytest  # noqa: E402
 
 @pytest.fixture(autouse=True)
 def _station_config_home(tmp_path_factory: pytest.TempPathFactory, monkeypatch) -> None:
-    """Every test (and every process it starts) keeps the station's signing key in a temporary
-    config folder and its gauge register in a temporary file, never in the real home."""
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path_factory.getbasetemp() / "config-home"))
+    """Every test (and every process it starts) keeps the station's signing key and its
+    remembered set-up in a temporary config folder of its own, never in the real home (and a
+    set-up remembered by one test never pre-fills another's form), and its gauge register in a
+    temporary file."""
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path_factory.mktemp("config-home")))
     # A gauge register of the test's own: a finished gauge check writes to it, and a new
     # session reads it; never the real one in the data folder.
     monkeypatch.setenv("STATION_GAUGES", str(tmp_path_factory.mktemp("gauges") / "gauges.json"))

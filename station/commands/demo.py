@@ -120,7 +120,7 @@ def _check_demo_choice(args: argparse.Namespace) -> None:
     here with a sentence (the TUI would open on it and wait forever)."""
     from station.errors import StationError
     from station.procedures import discover_procedures
-    from station.tui.screens.setup import count_field
+    from station.tui.screens.setup import DEMO_TRIAL_MINIMUM, count_field
 
     catalog = discover_procedures(args.procedures)
     if args.procedure not in catalog.ids():
@@ -129,8 +129,10 @@ def _check_demo_choice(args: argparse.Namespace) -> None:
         )
     if args.count is not None:
         count = count_field(catalog.get(args.procedure))
-        if args.count < count.minimum:
+        # A demo may be a short trial run (the set-up says the report's range).
+        minimum = min(count.minimum, DEMO_TRIAL_MINIMUM)
+        if args.count < minimum:
             raise StationError(
                 f"--count {args.count} is too few for {args.procedure}: "
-                f"give at least {count.minimum} {count.noun}"
+                f"give at least {minimum} {count.noun}"
             )

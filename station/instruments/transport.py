@@ -10,6 +10,7 @@ turns them into :class:`~station.errors.StationError` sentences that say what to
 from __future__ import annotations
 
 import errno
+import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -168,6 +169,37 @@ def _open_error(url: str, error: BaseException) -> StationError:
     return StationError(f"Could not open {url} ({text}): check the cable and the port name.")
 
 
+def own_terminal(path: str) -> bool:
+    """True when ``path`` is the terminal this process talks to the operator on (its standard
+    input, output or error): a pseudo-terminal number that once was a simulator's or a
+    recorded gauge line and is now the operator's own window."""
+    try:
+        device = os.stat(path).st_rdev
+    except OSError:
+        return False
+    if not device:
+        return False
+    for fd in (0, 1, 2):
+        try:
+            if os.isatty(fd) and os.fstat(fd).st_rdev == device:
+                return True
+        except OSError:
+            continue
+    return False
+
+
+def refuse_own_terminal(url: str) -> None:
+    """StationError when ``url`` is the station's own terminal. Opened as a gauge line, the
+    poll request (``1\\r``) is drawn on the operator's screen (a stray "1" at the top-left) and
+    the reader thread eats the operator's keys (issue 13, finding 10)."""
+    if own_terminal(url):
+        raise StationError(
+            f"{url} is this station's own terminal, not a gauge line (a pseudo-terminal number "
+            "is reused once its simulator or adapter is gone): name the gauges' port",
+            field="port",
+        )
+
+
 def open_port(
     url: str,
     settings: SerialSettings | None = None,
@@ -195,6 +227,8 @@ def open_port(
     kwargs: dict[str, object] = dict(settings.as_kwargs(), timeout=timeout)
     if exclusive and url_scheme(url) in (None, "hwgrep"):
         kwargs["exclusive"] = True
+    if url_scheme(url) is None:
+        refuse_own_terminal(url)
     try:
         return serial.serial_for_url(url, **kwargs)
     except termios.error as error:

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
+import errno
+import fcntl
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -104,3 +107,39 @@ def find_unfinished(folder: str | os.PathLike[str]) -> list[SessionSummary]:
     """The sessions that can be resumed (running or interrupted), newest first."""
     unfinished = [s for s in list_sessions(folder) if s.resumable]
     return sorted(unfinished, key=lambda s: s.created, reverse=True)
+
+
+def writer_alive(path: Path) -> bool:
+    """True when a live station process holds the session file open for writing (its writer's
+    exclusive ``flock``); False when nobody does, or the file cannot be opened.
+
+    The probe takes a shared lock for an instant and gives it back at once; a writer starting
+    in that instant is refused with its "open in another process" sentence and can be retried.
+    """
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except OSError as error:
+        return error.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES)
+    else:
+        with contextlib.suppress(OSError):
+            fcntl.flock(fd, fcntl.LOCK_UN)
+        return False
+    finally:
+        os.close(fd)
+
+
+def status_words(summary: SessionSummary, *, alive: bool | None = None) -> str:
+    """How a listing names a session's state. A file still marked ``running`` whose writer is
+    gone (no live lock) stopped without writing ``interrupted`` or ``finish``: a crash, a
+    power loss, a kill -9. ``alive`` is the writer probe's answer (asked when None)."""
+    if summary.error:
+        return "unreadable"
+    if summary.status == "running":
+        if alive is None:
+            alive = writer_alive(summary.path)
+        return "running now" if alive else "stopped without a word (crashed?)"
+    return str(summary.status or "")

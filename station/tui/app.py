@@ -21,14 +21,16 @@ import asyncio
 import signal
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from textual import work
+from textual import events, work
 from textual.app import App
 from textual.binding import Binding
+from textual.geometry import Size
 
 from station.errors import StationError
 from station.plain import plain
@@ -36,6 +38,9 @@ from station.tui.messages import RunnerChanged
 from station.tui.remedies import explained
 
 if TYPE_CHECKING:
+    from textual.app import SystemCommand
+    from textual.screen import Screen
+
     from station.procedures import ProcedureCatalog
     from station.run import Runner, RunnerNotice, RunnerState, SessionSetup
 
@@ -92,12 +97,23 @@ class StationApp(App[int]):
 
     CSS_PATH = Path(__file__).with_name("station.tcss")
     TITLE = "station"
-    ENABLE_COMMAND_PALETTE = False
-    BINDINGS = [Binding("ctrl+c", "quit_station", "Quit", show=False, priority=True)]
+    COMMAND_PALETTE_BINDING = "ctrl+p"
+    BINDINGS = [
+        Binding("ctrl+c", "quit_station", "Quit", show=False, priority=True),
+        Binding("question_mark", "keys", "Keys", show=False),
+    ]
 
     def __init__(self, config: StationConfig) -> None:
         super().__init__()
+        from station.tui.theme import HIGH_CONTRAST_THEME, apply_palette, wanted_theme
+
         self.config = config
+        # Verdicts and alarms by text attributes; without colour they name no colour at all.
+        self.register_theme(HIGH_CONTRAST_THEME)
+        theme = wanted_theme()
+        if theme is not None:
+            self.theme = theme
+        apply_palette(colour=not self.no_color and theme is None)
         self.runner: Runner | None = None
         self.session_header: dict[str, Any] = {}
         """The running session's header fields (robot, procedure, channels, unit, limits)."""
@@ -137,11 +153,41 @@ class StationApp(App[int]):
                 pass  # not the main thread (some test harnesses): nothing to restore then
         from station.tui.screens.home import HomeScreen
 
+        self.screen_change_signal.subscribe(self, lambda _screen: self.fit_to_terminal())
         self.push_screen(HomeScreen())
         if self.config.autopilot:
             from station.tui.autopilot import run_autopilot
 
             self.run_worker(run_autopilot(self), group="autopilot", exclusive=True)
+
+    def on_resize(self, event: events.Resize) -> None:
+        """Show the "terminal too small" notice, or take it away (this runs before Textual's
+        own handler stores the new size, so the size comes from the event)."""
+        self.fit_to_terminal(event.size)
+
+    def fit_to_terminal(self, size: Size | None = None) -> None:
+        """Below the smallest size the screens are laid out for, the current screen shows one
+        sentence (``TooSmallNotice``) instead of tables that lost their names and values."""
+        from station.tui.widgets.too_small import TooSmallNotice, too_small
+
+        size = size or self.size
+        small = too_small(size)
+        if small != self.has_class("-too-small"):
+            self.set_class(small, "-too-small")
+            # Textual restyles only the top screen on an app class change; the screens below
+            # are laid out at the new size too, and must not lay out their tables in 6 columns.
+            for screen in self.screen_stack:
+                screen.update_node_styles(animate=False)
+        if not small:
+            return
+        screen = self.screen
+        notices = screen.query(TooSmallNotice)
+        if notices:
+            notices.first().show_size(size)
+        else:
+            notice = TooSmallNotice()
+            screen.mount(notice)
+            notice.show_size(size)
 
     def on_unmount(self) -> None:
         """Remove the signal handlers and stop the instruments."""
@@ -154,7 +200,10 @@ class StationApp(App[int]):
         """SIGHUP or SIGTERM: write ``interrupted`` (the session stays resumable), then exit."""
         name = signal.Signals(signum).name
         self.interrupt_session(name)
-        self.exit(HANGUP_EXIT_CODES.get(signum, 1))
+        # Textual's signature is exit(result, return_code): the code must go by name, or it
+        # becomes the result and the process exits 0.
+        code = HANGUP_EXIT_CODES.get(signum, 1)
+        self.exit(code, return_code=code)
 
     def interrupt_session(self, reason: str) -> None:
         """Leave the running session resumable: the runner writes an ``interrupted`` event."""
@@ -176,9 +225,78 @@ class StationApp(App[int]):
             gauges.stop()
 
     async def action_quit_station(self) -> None:
-        """Ctrl+C: leave an unfinished session resumable, then quit."""
+        """Ctrl+C: leave an unfinished session resumable, then quit. Inside a dialog (a note
+        being typed, a question) it asks first, naming any half-typed text, so a stray Ctrl+C
+        does not throw the text away; a second Ctrl+C on that question quits."""
+        from textual.screen import ModalScreen
+
+        from station.tui.screens.dialogs import ConfirmScreen, QuitQuestion
+
+        screen = self.screen
+        if isinstance(screen, QuitQuestion):
+            self._quit_now()
+            return
+        if isinstance(screen, ModalScreen):
+            unsaved = ""
+            for widget in screen.query("Input"):
+                value = str(getattr(widget, "value", "")).strip()
+                if value:
+                    unsaved = value
+                    break
+            detail = "The session stays resumable."
+            if unsaved:
+                detail = (
+                    f"What you typed is not saved: “{plain(unsaved)}”. Press n to go back and "
+                    "finish it (Enter saves it). " + detail
+                )
+            question: ConfirmScreen = QuitQuestion("Quit station now?", detail)
+
+            def answered(yes: bool | None) -> None:
+                if yes:
+                    self._quit_now()
+
+            self.push_screen(question, answered)
+            return
+        self._quit_now()
+
+    def _quit_now(self) -> None:
         self.interrupt_session("quit")
         self.exit(0)
+
+    def get_system_commands(self, screen: Screen[Any]) -> Iterable[SystemCommand]:
+        """The command palette (Ctrl+P): every action of the current screen by name, with its
+        key, and this screen's keys. Textual's own entries (quit without writing
+        ``interrupted``, screenshots) are left out on purpose."""
+        from textual.app import SystemCommand
+
+        from station.tui.screens.dialogs import screen_keys
+
+        seen: set[str] = set()
+        for active in screen.active_bindings.values():
+            binding = active.binding
+            if not binding.description or binding.action in seen or not active.enabled:
+                continue
+            if binding.action in ("command_palette", "keys"):
+                continue
+            seen.add(binding.action)
+            key = self.get_key_display(binding)
+            yield SystemCommand(
+                binding.description,
+                f"key {key}",
+                partial(self._run_from_palette, binding.action, active.node),
+            )
+        if screen_keys(screen):
+            yield SystemCommand("Keys of this screen", "key ?", self.action_keys)
+
+    async def _run_from_palette(self, action: str, node: Any) -> None:
+        await self.run_action(action, node)
+
+    def action_keys(self) -> None:
+        """``?``: the keys of the current screen (and the help)."""
+        from station.tui.screens.dialogs import HelpScreen
+
+        if not isinstance(self.screen, HelpScreen):
+            self.push_screen(HelpScreen())
 
     def warm_up_analysis(self) -> None:
         """Load the analysis (numpy, scipy: about half a second) on a thread, early, so that
@@ -435,7 +553,9 @@ class StationApp(App[int]):
             self._replace_run_screen(DashboardScreen(live=True))
             return True
         if not wants_dashboard and not isinstance(screen, ChecklistScreen):
-            self._replace_run_screen(ChecklistScreen())
+            # From a capture back to the checklist: show what Space just recorded.
+            captured = state.last_cycle if isinstance(screen, DashboardScreen) else None
+            self._replace_run_screen(ChecklistScreen(just_captured=captured))
             return True
         return False
 

@@ -142,23 +142,33 @@ class DemoLab:
     (so the set-up's procedure picker switches the simulated set-up with the procedure)."""
 
     def __init__(
-        self, seed: int = 1990, *, stroke_points: int = 400, cycle_period: float | None = None
+        self,
+        seed: int = 1990,
+        *,
+        stroke_points: int = 400,
+        cycle_period: float | None = None,
+        link_prefix: str | None = None,
     ) -> None:
         self.seed = seed
         self.stroke_points = stroke_points
         self.cycle_period = cycle_period
         """The repeatability robot's round trip in seconds (None: it does not move)."""
+        self.link_prefix = link_prefix
+        """When set, each simulator's port is also a link named ``<prefix>-<procedure>`` (a
+        name that does not change from run to run, for the screen snapshots)."""
         self._fixtures: dict[str, DemoFixture] = {}
 
     def fixture(self, procedure: str) -> DemoFixture:
         """The running simulator for ``procedure`` (a fixture model for unknown ones)."""
         key = procedure if procedure in DEMO_PROCEDURES else "repeatability"
         if key not in self._fixtures:
+            link = f"{self.link_prefix}-{key}" if self.link_prefix else None
             self._fixtures[key] = start_demo_fixture(
                 self.seed,
                 procedure=key,
                 stroke_points=self.stroke_points,
                 cycle_period=self.cycle_period,
+                link=link,
             )
         return self._fixtures[key]
 
@@ -199,13 +209,16 @@ def test_connection(
     unit: str | None = None,
     resolution: float | None = None,
 ) -> Iterator[list[str]]:
-    """Open the line, take a few reading sets and yield the lines to show after each one;
-    with ``unit`` and ``resolution``, then judge the frames against them.
+    """Open the line, take a few reading sets and yield the lines to show after each one: the
+    values at the gauge's ``resolution`` (as the dashboard shows them) with their unit (the
+    frame's own, else ``unit``); with ``unit`` and ``resolution``, then judge the frames
+    against them.
 
     Nothing is recorded. Raises StationError when the port cannot be opened or stays silent,
     or when the frames disagree with the unit and resolution (naming both).
     """
     from station.instruments.units import describe_inference
+    from station.text import format_value
 
     # Arrival waits for the robot: the test polls (a push device is polled too, where it can).
     gauges = gauge_set(ports, "poll" if trigger in ("push", "arrival") else trigger)
@@ -222,8 +235,19 @@ def test_connection(
         for number in range(1, captures + 1):
             result = gauges.capture(timeout)
             values = "  ".join(
-                f"{channel}={reading.value:+.5f}" for channel, reading in result.readings.items()
+                f"{channel}={format_value(reading.value, resolution)}"
+                for channel, reading in result.readings.items()
             )
+            # The frame's own unit when it states one, else the set-up's (``unit`` of a
+            # reading without one is only the reader's default).
+            units = {
+                str(r.frame_unit)
+                for r in result.readings.values()
+                if getattr(r, "frame_unit", None)
+            }
+            shown_unit = units.pop() if len(units) == 1 else ("" if units else unit)
+            if values and shown_unit:
+                values += f" {shown_unit}"
             note = f"  ({result.message})" if result.message else ""
             lines = [*lines, f"  {number}: {values or 'no reading'}{note}"]
             yield lines

@@ -11,7 +11,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from rich.text import Text
-from textual import work
+from textual import events, work
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical, VerticalScroll
@@ -21,6 +21,7 @@ from textual.widgets import Footer, Input, Label, Static
 from station.errors import StationError
 from station.tui.remedies import explained
 from station.tui.text import shown, shown_line
+from station.tui.widgets.fields import mark_focused_row
 from station.tui.widgets.step_list import StepList
 
 if TYPE_CHECKING:
@@ -47,8 +48,11 @@ class ChecklistScreen(Screen[None]):
 
     app: StationApp
 
-    def __init__(self) -> None:
+    def __init__(self, just_captured: Any = None) -> None:
         super().__init__()
+        self._just_captured = just_captured
+        """The reading set the dashboard captured before handing over (a placement's error):
+        shown until the next step is done, so Space never jumps past what it recorded."""
         self._shown_step: tuple[int, str] | None = None
         self.busy = False
         """True while the runner carries out a step (keys for another step wait for it)."""
@@ -59,12 +63,15 @@ class ChecklistScreen(Screen[None]):
         with Horizontal(id="checklist"):
             with VerticalScroll(id="steps-box"):
                 yield StepList(id="steps")
-            with Vertical(id="step-panel"):
+            # Scrolls, so the fields of an input step (the pendant's X, Y, Z) are brought into
+            # view as they take the focus at 80×24.
+            with VerticalScroll(id="step-panel"):
                 yield Static(id="step-title")
                 yield Static(id="step-text")
                 # What Enter does and why a value was refused stay in view above the fields.
                 yield Static(id="step-action")
                 yield Static(id="step-message")
+                yield Static(id="step-captured")
                 yield Vertical(id="step-inputs")
         yield Footer()
 
@@ -73,6 +80,10 @@ class ChecklistScreen(Screen[None]):
         state = self.app.current_state()
         if state is not None:
             self.show_state(state)
+        if self._just_captured is not None:
+            self.query_one("#step-captured", Static).update(
+                captured_text(self._just_captured, self.app.session_header)
+            )
 
     def show_state(self, state: RunnerState) -> None:
         """Redraw from a runner snapshot (UI thread)."""
@@ -81,12 +92,25 @@ class ChecklistScreen(Screen[None]):
         current = state.current
         key = (current.index, current.id) if current is not None else None
         if key != self._shown_step:
+            if self._shown_step is not None:
+                self.query_one("#step-captured", Static).update("")
             self._shown_step = key
             self._show_step(current, state.placements, state.action)
         message = state.messages[-1] if state.messages else None
         if message is not None:
             style = {"error": "bold red", "warning": "yellow"}.get(message.level, "green")
-            self.query_one("#step-message", Static).update(shown(message.text, style=style))
+            line = self.query_one("#step-message", Static)
+            is_path = message.text == f"Session file {state.path}."
+            if is_path:
+                # A path has no spaces to wrap at: the folder on one line, cut with an
+                # ellipsis rather than broken mid-word (the title above names the file).
+                text = shown("Session file in ", style=style)
+                text.append(shown_line(f"{state.path.parent}/", limit=None), style=style)
+            else:
+                text = shown(message.text, style=style)
+            line.styles.text_wrap = "nowrap" if is_path else "wrap"
+            line.styles.text_overflow = "ellipsis" if is_path else "fold"
+            line.update(text)
 
     def _show_step(
         self, view: StepView | None, placements: int | None = None, todo: Action | None = None
@@ -143,9 +167,15 @@ class ChecklistScreen(Screen[None]):
         unit = str(self.app.session_header.get("unit") or "in")
         return str(placement.pendant_text(unit))
 
+    def on_descendant_focus(self, event: events.DescendantFocus) -> None:
+        """Mark the focused field's row (its label in reverse video)."""
+        mark_focused_row(self, event.widget)
+
     def _focus_first_input(self) -> None:
         for widget in self.query("#step-inputs Input"):
             widget.focus()
+            # All the fields in view at once (at 80×24 they sit below the step's text).
+            self.query_one("#step-inputs").scroll_visible(animate=False)
             return
 
     # -- actions --------------------------------------------------------------------------
@@ -230,6 +260,22 @@ class ChecklistScreen(Screen[None]):
             ),
             callback=leave,
         )
+
+
+def captured_text(record: Any, header: dict[str, Any]) -> Text:
+    """``Captured (set 3): x +0.0003  y -0.0001  z +0.0002 in``: the set just recorded, at
+    the gauge's resolution."""
+    from station.text import format_value
+
+    resolution = header.get("resolution")
+    unit = str(header.get("unit") or "")
+    text = Text(f"Captured (set {record.cycle}): ", style="bold")
+    values = "  ".join(
+        f"{shown_line(channel, limit=20)} {format_value(value, resolution)}"
+        for channel, value in record.values.items()
+    )
+    text.append(f"{values} {unit}".rstrip(), style="bold")
+    return text
 
 
 def _run_title(state: RunnerState) -> Text:

@@ -101,7 +101,8 @@ class DashboardView:
         if state.placement is not None and state.placements:
             progress = f"placement {state.placement} of {state.placements}, {progress}"
         if ready:
-            prompt = "Every cycle asked for is captured. Press f to finish and see the verdict."
+            noun = counted.noun if counted is not None else "cycle"
+            prompt = f"Every {noun} asked for is captured. Press f to finish and see the verdict."
         if rejected:
             progress += f", {rejected} rejected"
         if last_cycle is not None and last_cycle.rejected is not None:
@@ -171,6 +172,7 @@ class DashboardScreen(Screen[None]):
         Binding("z", "axis('z')", "z", show=False),
         Binding("f1", "help", "Help"),
         Binding("question_mark", "help", "Help", show=False),
+        Binding("m", "full_text", "Messages in full", show=False),
         Binding("q", "leave", "Leave"),
         Binding("escape", "back", "Back", show=False),
     ]
@@ -497,6 +499,18 @@ class DashboardScreen(Screen[None]):
         from station.tui.screens.dialogs import HelpScreen
 
         self.app.push_screen(HelpScreen())
+
+    def action_full_text(self) -> None:
+        """``m``: the newest message and every alarm, in full (the lines here cut them)."""
+        from station.tui.screens.dialogs import FullTextScreen
+
+        view = self.view
+        lines: list[str] = []
+        if view is not None:
+            if view.message is not None:
+                lines.append(f"Newest message: {view.message.text}")
+            lines.extend(alarm_lines(view.analyses, view.cycle_numbers))
+        self.app.push_screen(FullTextScreen("Messages and alarms in full", lines))
 
     def action_back(self) -> None:
         """Reviewing: back to the summary."""

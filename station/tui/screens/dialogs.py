@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Vertical, VerticalScroll
-from textual.screen import ModalScreen
+from textual.screen import ModalScreen, Screen
 from textual.widgets import Footer, Input, Static
 
 from station.tui.text import shown
@@ -79,42 +80,81 @@ class ConfirmScreen(ModalScreen[bool]):
         self.dismiss(answer)
 
 
+class QuitQuestion(ConfirmScreen):
+    """Ctrl+C inside a dialog: quit now? (n goes back to the dialog, its text kept)."""
+
+
 HELP_TEXT = """\
-[b]Home[/b]  ↑ ↓ choose · Enter open · n new session · r resume · v review · q quit
+[b]Home[/b]  ↑ ↓ choose · Enter open · n new session · r resume
+  v review · q quit
 
-[b]Set-up[/b]  Tab / Shift+Tab move between fields · F3 test connection · F2 start
-  Limits: ±0.001 (a tolerance about nominal 0) or -0.001:0.001 (LSL:USL); one side may be empty.
-  Port: pick a detected port or type /dev/ttyUSB0, /dev/pts/N, rfc2217://host:port, socket://host:port.
+[b]Set-up[/b]  Tab / Shift+Tab move between fields · F3 test connection
+  F2 start. Limits: ±0.001 (a tolerance about nominal 0) or
+  -0.001:0.001 (LSL:USL); one side may be empty. Port: pick a detected
+  port or type /dev/ttyUSB0, rfc2217://host:port or socket://host:port.
 
-[b]Checklist[/b]  Enter confirms the step (zeroes at a zero step, saves typed values at an
-  input step) · n note · q leave (the session stays resumable)
+[b]Checklist[/b]  Enter confirms the step (zeroes at a zero step, saves
+  typed values at an input step) · n note · q leave (resumable)
 
-[b]Capture[/b]  Space capture a cycle · r reject the last cycle (asks why; nothing is deleted)
-  n note · p pause / continue · f finish · x y z or Tab choose the axis in the charts
-  g go on to the next step (once the step has its minimum cycles, e.g. the next joint)
-  a alarms: the full list, scrollable; a on an alarm acknowledges it with a cause from the
-  procedure's list, what it was and the corrective action (written to the session file)
-  q leave (the session stays resumable)
-  A reading beyond a specification limit is marked ▲ (above the USL) or ▼ (below the LSL) at
-  once; the column "out" counts each axis' readings out of specification.
+[b]Capture[/b]  Space capture a cycle · r reject the last cycle (asks
+  why; nothing is deleted) · n note · p pause / continue · f finish
+  x y z or Tab choose the axis · q leave (resumable)
+  g go on to the next step (once the step has its minimum, e.g. the
+  next joint) · a the alarm list: acknowledge an alarm with a cause
+  from the procedure's list, what it was and the corrective action
+  A reading beyond a limit is marked ▲ (above the USL) or ▼ (below
+  the LSL) at once; the column "out" counts them per axis.
 
-[b]Strokes[/b]  (linearity) the strokes stream as the robot shuttles A↔B · e end the stroke
-  now (streaming stops; Space streams again) · f finish · h v or Tab choose the indicator
+[b]Strokes[/b]  (linearity) the strokes stream as the robot shuttles
+  A↔B · e end the stroke now (Space streams again) · f finish
+  h v or Tab choose the indicator
 
-[b]Summary[/b]  e export the text report · c export CSV · d charts · h home · q quit
+[b]Summary[/b]  e export the text report · c export CSV · d charts
+  h home · q quit
 
-Every reading is on disk (fsynced) before it is shown as captured. If the link drops, the
-session is marked interrupted; run `station` again and choose Resume.
-Verdicts: CAPABLE when Cpk ≥ the threshold (1.00 by default), NOT CAPABLE otherwise,
-UNDEFINED when there are no limits or too few readings. PROVISIONAL: 9 of 25 while fewer
-readings than the procedure's minimum are in (the Cpk shown is where the figures point so far).
-The Cpk is shown with as many decimals as it takes to sit on the same side of the threshold.
-Alarms: report rule 1 = a point beyond the control limits; report rule 2 = seven points in a
-row going up or down; report rule 3 = fifteen points in a row alternating up and down; report
-rule 4 = two of three points beyond 2 sigma on one side; drift rule = the EWMA of the mean
-beyond its limits. Live alarms are judged against control limits frozen after the first
-cycles (phase II), so an alarm once raised never goes away.
+[b]Everywhere[/b]  ? the keys of the screen · Ctrl+P every action by
+  name · Ctrl+C quit (inside a dialog it asks first)
+
+Every reading is on disk (fsynced) before it is shown as captured.
+If the link drops, the session is marked interrupted; run `station`
+again and choose Resume. Verdicts: CAPABLE when Cpk ≥ the threshold
+(1.00 by default), NOT CAPABLE otherwise, UNDEFINED when there are no
+limits or too few readings.
+PROVISIONAL: 9 of 25 while fewer readings than the procedure's
+minimum are in. The Cpk is shown with as many decimals as it takes
+to sit on the same side of the threshold. Alarms: report rule 1 = a
+point beyond the control limits; rule 2 = seven points in a row going
+up or down; rule 3 = fifteen points alternating up and down; rule 4 =
+two of three points beyond 2 sigma on one side; drift = the EWMA of
+the mean beyond its limits. Live alarms are judged against control
+limits frozen after the first cycles, so an alarm never goes away.
 """
+
+
+APP_KEYS = ("quit_station", "command_palette")
+"""The app's own keys listed beside a screen's (Textual's built-in ones are left out)."""
+
+
+def screen_keys(screen: Screen[object]) -> list[tuple[str, str]]:
+    """The keys ``screen`` answers now: its own first, in the footer's order, then Ctrl+C;
+    a list's or a field's own movement keys are left out (they are the same everywhere), as
+    are keys without a description (they repeat one that has it, e.g. ``x`` beside Tab)."""
+    app = screen.app
+    own: list[tuple[str, str]] = []
+    general: list[tuple[str, str]] = []
+    seen: set[str] = set()
+    for active in screen.active_bindings.values():
+        binding = active.binding
+        if not binding.description or binding.action in seen or not active.enabled:
+            continue
+        if active.node is screen:
+            own.append((app.get_key_display(binding), binding.description))
+        elif active.node is app and binding.action in APP_KEYS:
+            general.append((app.get_key_display(binding), binding.description))
+        else:
+            continue
+        seen.add(binding.action)
+    return own + general
 
 
 class HelpScreen(ModalScreen[None]):
@@ -127,9 +167,46 @@ class HelpScreen(ModalScreen[None]):
     ]
 
     def compose(self) -> ComposeResult:
-        """The help text in a scrolling box."""
+        """The keys of the screen underneath first, then the help text, in a scrolling box."""
         with VerticalScroll(classes="dialog help"):
+            underneath = [screen for screen in self.app.screen_stack if screen is not self]
+            keys = screen_keys(underneath[-1]) if underneath else []
+            if keys:
+                text = Text("Keys of this screen\n", style="bold")
+                for key, description in keys:
+                    text.append(f"  {key:<12}", style="bold")
+                    text.append(f" {description}\n")
+                if not any(description == "palette" for _, description in keys):
+                    text.append("  ^p           every action of this screen by name\n")
+                yield Static(text, id="help-keys")
             yield Static(HELP_TEXT)
+        yield Footer()
+
+    def action_close(self) -> None:
+        """Back to the screen underneath."""
+        self.dismiss(None)
+
+
+class FullTextScreen(ModalScreen[None]):
+    """A long text in full (the alarm log and the message line cut theirs to one line each):
+    wrapped, scrollable, closed with Escape."""
+
+    BINDINGS = [
+        Binding("escape", "close", "Close"),
+        Binding("q", "close", "Close", show=False),
+    ]
+
+    def __init__(self, title: str, lines: list[str]) -> None:
+        super().__init__()
+        self._title = title
+        self._lines = lines
+
+    def compose(self) -> ComposeResult:
+        """The title and each line in full, in a scrolling box."""
+        with VerticalScroll(classes="dialog help"):
+            yield Static(shown(self._title, style="bold"), classes="dialog-title")
+            body = "\n\n".join(self._lines) if self._lines else "Nothing to show yet."
+            yield Static(shown(body), id="full-text")
         yield Footer()
 
     def action_close(self) -> None:

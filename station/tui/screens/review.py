@@ -1,10 +1,18 @@
-"""Review: the saved sessions by robot and date; Enter opens one read-only (summary, charts)."""
+"""Review: the saved sessions by robot and date; Enter opens one read-only (summary, charts).
+
+Each row says the verdict of a finished session (worked out on a thread, filled in as it
+comes), and the state of an unfinished one: ``interrupted``, ``running now`` (a live station
+holds its lock) or ``stopped without a word (crashed?)`` (marked running, but no writer is
+left). ``/`` shows one robot's sessions.
+"""
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rich.text import Text
+from textual import work
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.screen import Screen
@@ -26,6 +34,7 @@ class ReviewScreen(Screen[None]):
         Binding("h", "history", "Robot history"),
         Binding("m", "mark", "Mark for compare"),
         Binding("c", "compare", "Compare with mark"),
+        Binding("slash", "filter", "Robot filter", key_display="/"),
         Binding("escape", "back", "Back"),
         Binding("f1", "help", "Help"),
         Binding("q", "back", "Back", show=False),
@@ -37,6 +46,9 @@ class ReviewScreen(Screen[None]):
         super().__init__()
         self._sessions: list[Any] = []
         self._marked: Any = None
+        self._all: list[Any] = []
+        self._robot_filter = ""
+        self._verdicts: dict[Path, str] = {}
 
     def compose(self) -> ComposeResult:
         """Title, the table, the folder."""
@@ -50,13 +62,34 @@ class ReviewScreen(Screen[None]):
         from station.session.store import list_sessions
 
         folder = self.app.config.sessions_dir
-        self._sessions = list(list_sessions(folder))
+        self._all = list(list_sessions(folder))
         table = self.query_one(DataTable)
-        table.add_columns("robot", "created (UTC)", "procedure", "status", "cycles")
+        # A finished session's verdict and an unfinished one's state share a column: one of
+        # them is all a row has, and both fit 80 columns beside the robot and the date.
+        table.add_column("robot", key="robot")
+        table.add_column("created (UTC)", key="created")
+        table.add_column("verdict / state", key="verdict")
+        table.add_column("procedure", key="procedure")
+        table.add_column("cycles", key="cycles")
+        self._fill()
+        table.focus()
+        finished = [s.path for s in self._all if not s.error and s.status == "finished"]
+        if finished:
+            self._work_out_verdicts(finished)
+
+    def _fill(self) -> None:
+        """The rows of the sessions the robot filter lets through."""
+
+        table = self.query_one(DataTable)
+        table.clear()
+        wanted = self._robot_filter.casefold()
+        self._sessions = [
+            s for s in self._all if not wanted or wanted in (s.robot or "").casefold()
+        ]
         for index, summary in enumerate(self._sessions):
             if summary.error:
                 table.add_row(
-                    shown(summary.path.name, limit=120), "", "", "unreadable", "", key=str(index)
+                    shown(summary.path.name, limit=120), "", "unreadable", "", "", key=str(index)
                 )
                 continue
             cycles = f"{summary.cycles}"
@@ -66,17 +99,74 @@ class ReviewScreen(Screen[None]):
                 cycles += f" ({summary.rejected} rej.)"
             table.add_row(
                 shown(summary.robot, limit=60),
-                shown(summary.created[:19].replace("T", " ")),
+                shown(summary.created[:16].replace("T", " ")),
+                self._verdict_cell(summary),
                 shown(summary.procedure, limit=60),
-                shown(summary.status or ""),
                 cycles,
                 key=str(index),
             )
-        note = f"{len(self._sessions)} session(s) in {folder}"
-        if not self._sessions:
+        folder = self.app.config.sessions_dir
+        note = f"{len(self._all)} session(s) in {folder}"
+        if self._robot_filter:
+            note = (
+                f"{len(self._sessions)} of {len(self._all)} session(s), robot "
+                f"“{self._robot_filter}” (/ to change), in {folder}"
+            )
+        if not self._all:
             note = f"No session files in {folder} yet."
         self.query_one("#review-folder", Static).update(shown(note, style="dim"))
-        table.focus()
+
+    def _verdict_cell(self, summary: Any) -> Text:
+        from station.session.store import status_words
+        from station.tui.widgets.figures import VERDICT_STYLES
+
+        if summary.error or summary.status != "finished":
+            return shown(status_words(summary))
+        word = self._verdicts.get(summary.path)
+        if word is None:
+            return Text("…")
+        return Text(word, style=VERDICT_STYLES.get(word, ""))
+
+    @work(thread=True, group="review-verdicts", exclusive=True, exit_on_error=False)
+    def _work_out_verdicts(self, paths: list[Path]) -> None:
+        """Thread worker: each finished session's overall verdict, as the summary says it."""
+        from station.tui.screens.summary import SummaryView
+        from station.tui.widgets.figures import overall_verdict, verdict_word
+
+        for path in paths:
+            try:
+                view = SummaryView.from_file(path)
+                channels = getattr(view.analysis, "channels", {}) or {}
+                word = overall_verdict([verdict_word(c.capability) for c in channels.values()])
+            except (StationError, OSError, ValueError, AttributeError):
+                word = "—"
+            self.app.call_from_thread(self._show_verdict, path, word)
+
+    def _show_verdict(self, path: Path, word: str) -> None:
+        self._verdicts[path] = word
+        table = self.query_one(DataTable)
+        for index, summary in enumerate(self._sessions):
+            if summary.path == path:
+                table.update_cell(str(index), "verdict", self._verdict_cell(summary))
+
+    def action_filter(self) -> None:
+        """``/``: show one robot's sessions (part of the name, any case; empty shows all)."""
+        from station.tui.screens.dialogs import TextPrompt
+
+        def chosen(text: str | None) -> None:
+            if text is None:
+                return
+            self._robot_filter = "" if text.strip() in ("", "*") else text.strip()
+            self._fill()
+
+        self.app.push_screen(
+            TextPrompt(
+                "Robot filter",
+                "Show the sessions of the robot named (part of the name is enough; * for all).",
+                placeholder="robot name or asset number",
+            ),
+            chosen,
+        )
 
     def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
         """Enter on a row."""

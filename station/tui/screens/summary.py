@@ -141,6 +141,24 @@ def report_text(view: SummaryView) -> Text:
     return shown("\n".join(view.report.lines), no_wrap=True, overflow="crop")
 
 
+def one_sided_sentence(capability: Any, decimals: int, unit: str) -> str:
+    """Why Cp shows "—" beside a Cpk: a limit on one side only (the straightness of a stroke,
+    never below 0, against its tolerance) is judged one-sided; "" for two-sided limits."""
+    lsl = getattr(capability, "lsl", None)
+    usl = getattr(capability, "usl", None)
+    if (lsl is None) == (usl is None):
+        return ""
+    if usl is not None:
+        return (
+            f"one-sided: upper limit {number(usl, decimals, signed=False)} {unit} only; "
+            "Cpk = (USL − X̄)/3σ, Cp needs two limits."
+        )
+    return (
+        f"one-sided: lower limit {number(lsl, decimals)} {unit} only; "
+        "Cpk = (X̄ − LSL)/3σ, Cp needs two limits."
+    )
+
+
 def verdict_text(view: SummaryView) -> Text:
     """The verdict block: overall, then one line per axis with Cp, Cpk and the reason, and the
     readings out of specification."""
@@ -173,6 +191,9 @@ def verdict_text(view: SummaryView) -> Text:
         )
         if word == "UNDEFINED" and capability.message:
             text.append(f"      {shown_line(capability.message, limit=None)}\n", style="yellow")
+        one_sided = one_sided_sentence(capability, view.decimals, view.unit)
+        if one_sided:
+            text.append(f"      {one_sided}\n")
         found = channel.out_of_spec
         if found is not None and found.total:
             cycles = ", ".join(str(c) for c in found.cycles)
@@ -330,7 +351,18 @@ class SummaryScreen(Screen[None]):
             yield report
             yield Static(hints_text(self.view), id="summary-hints")
             yield Static(file_text(self.view, self.exported), id="summary-file")
+        # Exports and refusals are said on this line, not in toasts over the verdict.
+        yield Static("", id="summary-message")
         yield Footer()
+
+    def notify(  # type: ignore[override]
+        self, message: str, *, severity: str = "information", markup: bool = True, **_: Any
+    ) -> None:
+        """Say ``message`` on the summary's own message line (a toast would cover the
+        summary's text); errors in bold, as words, not only a colour."""
+        style = {"error": "bold red", "warning": "bold yellow"}.get(severity, "green")
+        prefix = {"error": "Error: ", "warning": "Warning: "}.get(severity, "")
+        self.query_one("#summary-message", Static).update(shown(prefix + message, style=style))
 
     def _refresh_file(self) -> None:
         self.query_one("#summary-file", Static).update(file_text(self.view, self.exported))

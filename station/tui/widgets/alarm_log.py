@@ -12,6 +12,7 @@ from rich.text import Text
 from textual.widgets import Static
 
 from station.tui.text import shown_line
+from station.tui.theme import ALARM_STYLES
 
 
 def alarm_lines(
@@ -89,7 +90,7 @@ class AlarmLog(Static):
         self._lines = list(lines)
         self._extra = extra
         if not lines:
-            self.update(Text(empty, style="dim"))
+            self.update(Text(empty, style=ALARM_STYLES["none"]))
             return
         shown = lines[-self.max_shown :]
         counts = f"{len(lines)}"
@@ -98,7 +99,7 @@ class AlarmLog(Static):
         if len(lines) > self.max_shown:
             counts += f", newest {len(shown)}"
         head = f"alarms ({counts})" + (f" · {more}:" if more else ":")
-        text = Text(head, style="bold red", no_wrap=True, overflow="ellipsis")
+        text = Text(head, style=ALARM_STYLES["head"], no_wrap=True, overflow="ellipsis")
         for line in shown:
-            text.append("\n⚠ " + shown_line(line), style="red")
+            text.append("\n⚠ " + shown_line(line), style=ALARM_STYLES["line"])
         self.update(text)

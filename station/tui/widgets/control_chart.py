@@ -52,7 +52,21 @@ def chart_data(
     ``label`` names the points (``stroke`` for a linearity run's straightness chart)."""
     chart = getattr(channel, "chart", None)
     if chart is None:
-        return None
+        # "no readings yet" only when there are none: a single reading has no chart yet.
+        n = int(getattr(getattr(channel, "descriptive", None), "n", 0) or 0)
+        if n <= 0:
+            return None
+        return ChartData(
+            points=(),
+            center=None,
+            ucl=None,
+            lcl=None,
+            alarm_points=frozenset(),
+            labels=(),
+            decimals=decimals,
+            message=f"control chart: {n} {label} so far, it starts at the 2nd",
+            label=label,
+        )
     points = tuple(float(p) for p in getattr(chart, "points", ()))
     alarmed: set[int] = set()
     for alarm in getattr(channel, "alarms", ()) or ():
@@ -80,8 +94,12 @@ def chart_data(
 
 def render_chart(data: ChartData | None, width: int, height: int) -> Text:
     """The chart as ``height`` lines of ``width`` cells."""
-    if data is None or not data.points or width < _GUTTER + 8 or height < 5:
+    if data is not None and not data.points and data.message:
+        return Text(data.message, style="dim")
+    if data is None or not data.points:
         return Text("no readings yet", style="dim")
+    if width < _GUTTER + 8 or height < 5:
+        return Text("control chart: too little room to draw", style="dim")
     plot_width = width - _GUTTER - 1
     rows = height - 2  # a title line and the cycle-number line
     # One column per point when crowded, up to three when there is room; the newest points win.

@@ -7,14 +7,11 @@ from __future__ import annotations
 
 import math
 
-NOT_AVAILABLE = "—"
+from station.tui.theme import VERDICT_STYLES
 
-VERDICT_STYLES = {
-    "CAPABLE": "bold green",
-    "NOT CAPABLE": "bold red",
-    "UNDEFINED": "bold yellow",
-    "PROVISIONAL": "bold yellow",
-}
+__all__ = ["VERDICT_STYLES", "NOT_AVAILABLE"]
+
+NOT_AVAILABLE = "—"
 
 
 def decimals_for(resolution: float | None) -> int:

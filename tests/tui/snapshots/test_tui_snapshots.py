@@ -63,6 +63,11 @@ def test_summary_of_a_saved_session(snap_compare, monkeypatch: pytest.MonkeyPatc
     async def review(pilot) -> None:
         await pilot.press("v")
         await pilot.pause()
+        # R1's session (the folder also keeps the other procedures' sessions).
+        table = pilot.app.screen.query_one("#review-table")
+        table.move_cursor(
+            row=[str(r[0]) for r in map(table.get_row_at, range(table.row_count))].index("R1")
+        )
         await pilot.press("enter")
         await tui.wait_until(pilot, lambda: isinstance(pilot.app.screen, SummaryScreen))
         await pilot.pause()

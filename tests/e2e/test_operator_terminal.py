@@ -1,0 +1,197 @@
+"""The operator's terminal, for real: ``station`` in tmux, signals sent to its process, the exit
+status read back from the dead pane (issue 13: the TUI exited 0 after SIGHUP/SIGTERM)."""
+
+from __future__ import annotations
+
+import os
+import shlex
+import shutil
+import signal
+import subprocess
+import sys
+import time
+import uuid
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.skipif(shutil.which("tmux") is None, reason="tmux is not installed")
+
+
+def _tmux(*args: str) -> str:
+    return subprocess.run(["tmux", *args], capture_output=True, text=True, check=False).stdout
+
+
+class Pane:
+    """One detached tmux session that stays after its command exits (to read the status)."""
+
+    def __init__(self, command: list[str], cwd: Path, size: tuple[int, int] = (80, 24)) -> None:
+        self.name = f"station-op-{uuid.uuid4().hex[:8]}"
+        env = f"TERM=xterm-256color XDG_CONFIG_HOME={shlex.quote(os.environ['XDG_CONFIG_HOME'])}"
+        shell = f"cd {shlex.quote(str(cwd))} && {env} exec {shlex.join(command)}"
+        subprocess.run(
+            ["tmux", "new-session", "-d", "-s", self.name, "-x", str(size[0]), "-y", str(size[1])]
+            + [shell],
+            check=True,
+        )
+        _tmux("set-option", "-t", self.name, "remain-on-exit", "on")
+        self.pid = int(_tmux("display-message", "-p", "-t", self.name, "#{pane_pid}").strip())
+
+    def screen(self) -> str:
+        return _tmux("capture-pane", "-p", "-t", self.name)
+
+    def wait_for(self, text: str, timeout: float) -> str:
+        deadline = time.monotonic() + timeout
+        screen = ""
+        while time.monotonic() < deadline:
+            screen = self.screen()
+            if text in screen:
+                return screen
+            time.sleep(0.1)
+        pytest.fail(f"{text!r} did not appear within {timeout} s; the screen shows:\n{screen}")
+
+    def exit_status(self, timeout: float) -> int:
+        """The command's exit status once the pane is dead."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            fields = _tmux(
+                "display-message", "-p", "-t", self.name, "#{pane_dead} #{pane_dead_status}"
+            )
+            dead, _, status = fields.strip().partition(" ")
+            if dead == "1" and status:
+                return int(status)
+            time.sleep(0.1)
+        fields = _tmux(
+            "display-message",
+            "-p",
+            "-t",
+            self.name,
+            "dead=#{pane_dead} status=#{pane_dead_status} signal=#{pane_dead_signal}",
+        )
+        pytest.fail(f"station did not exit within {timeout} s ({fields}):\n{self.screen()}")
+
+    def close(self) -> None:
+        subprocess.run(["tmux", "kill-session", "-t", self.name], capture_output=True, check=False)
+
+
+class PtyProcess:
+    """``station`` on a real pseudo-terminal of 80×24 (not tmux: its pane can lose the exit
+    status), its output drained on a thread so it never blocks on a full terminal; ``{tty}``
+    in an argument is the terminal's own name."""
+
+    def __init__(self, args: list[str], cwd: Path, stderr=None) -> None:
+        import fcntl
+        import struct
+        import termios
+        import threading
+
+        master, slave = os.openpty()
+        fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 80, 0, 0))
+        self.tty = os.ttyname(slave)
+        env = dict(os.environ, TERM="xterm-256color")
+        self.process = subprocess.Popen(
+            [arg.replace("{tty}", self.tty) for arg in args],
+            stdin=slave,
+            stdout=slave,
+            stderr=slave if stderr is None else stderr,
+            cwd=cwd,
+            env=env,
+            start_new_session=True,
+        )
+        os.close(slave)
+        self._master = master
+        self.output = bytearray()
+        self._reader = threading.Thread(target=self._drain, daemon=True)
+        self._reader.start()
+
+    def _drain(self) -> None:
+        while True:
+            try:
+                chunk = os.read(self._master, 65536)
+            except OSError:
+                return
+            if not chunk:
+                return
+            self.output.extend(chunk)
+
+    def wait_for(self, text: str, timeout: float) -> None:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if text.encode() in self.output:
+                return
+            time.sleep(0.05)
+        pytest.fail(f"{text!r} was not drawn within {timeout} s")
+
+    def close(self) -> None:
+        if self.process.poll() is None:
+            self.process.kill()
+            self.process.wait(10)
+        os.close(self._master)
+
+
+@pytest.mark.parametrize(
+    ("signum", "code"), [(signal.SIGHUP, 129), (signal.SIGTERM, 143)], ids=["SIGHUP", "SIGTERM"]
+)
+def test_the_tui_exits_128_plus_the_signal(tmp_path: Path, signum: int, code: int) -> None:
+    station = PtyProcess([sys.executable, "-m", "station", "--sessions", str(tmp_path)], tmp_path)
+    try:
+        station.wait_for("New session", timeout=30)
+        station.process.send_signal(signum)
+        assert station.process.wait(20) == code
+    finally:
+        station.close()
+
+
+def test_the_stations_own_terminal_is_refused_as_a_gauge_line(tmp_path: Path) -> None:
+    """Finding 10: a pseudo-terminal number reused by the operator's own window, typed or
+    recorded as the gauge port, was opened; the poll request "1\\r" was drawn at the top-left
+    and the reader thread ate keys. Now it is refused with a sentence."""
+    pane = Pane([sys.executable, "-m", "station", "--sessions", str(tmp_path)], tmp_path)
+    try:
+        pane.wait_for("New session", timeout=30)
+        tty = _tmux("display-message", "-p", "-t", pane.name, "#{pane_tty}").strip()
+        _tmux("send-keys", "-t", pane.name, "n")
+        pane.wait_for("Tab / Shift+Tab", timeout=30)
+        _tmux("send-keys", "-t", pane.name, "R1")
+        for _ in range(10):  # robot → ... → the port field
+            _tmux("send-keys", "-t", pane.name, "Tab")
+        pane.wait_for("Port", timeout=10)
+        _tmux("send-keys", "-t", pane.name, "-l", tty)
+        time.sleep(0.5)
+        _tmux("send-keys", "-t", pane.name, "F3")
+        screen = pane.wait_for("own terminal", timeout=20)
+        assert "Connected to" not in screen
+    finally:
+        pane.close()
+
+
+def test_station_read_refuses_its_own_terminal(tmp_path: Path) -> None:
+    """The same guard at the transport: every command that opens a gauge line refuses the
+    terminal it runs in (and so does the reader's reconnect)."""
+    errors = tmp_path / "stderr.txt"
+    command = [sys.executable, "-m", "station", "read", "--port", "{tty}", "--protocol"]
+    with errors.open("wb") as sink:
+        read = PtyProcess([*command, "mitutoyo", "--count", "1"], tmp_path, stderr=sink)
+        try:
+            code = read.process.wait(30)
+        finally:
+            read.close()
+    assert code == 2, errors.read_text()
+    assert "is this station's own terminal, not a gauge line" in errors.read_text()
+
+
+@pytest.mark.parametrize("procedure", ["repeatability", "relative_accuracy", "linearity"])
+def test_demo_autopilot_count_5_ends_on_the_verdict(tmp_path: Path, procedure: str) -> None:
+    """``station demo --autopilot --count 5`` of each procedure (a short trial run, below the
+    report's 25 cycles for repeatability) walks to the summary and shows the verdict."""
+    command = [sys.executable, "-m", "station", "demo", "--procedure", procedure]
+    pane = Pane(
+        [*command, "--autopilot", "--count", "5", "--pace", "0.05", "--sessions", str(tmp_path)],
+        tmp_path,
+    )
+    try:
+        screen = pane.wait_for("Verdict:", timeout=180)
+        verdict = next(line for line in screen.splitlines() if "Verdict:" in line)
+        assert verdict.split("Verdict:")[1].split()[0] in ("CAPABLE", "NOT", "UNDEFINED")
+    finally:
+        pane.close()
