@@ -5,7 +5,8 @@ Front ends import from here: :class:`Runner` (the engine), :class:`SessionSetup`
 (:class:`RunnerState`, :class:`Action`, :class:`Progress`, :class:`RunnerNotice`).
 """
 
-from station.run.engine import CAPTURE_BY, DEVICE_DRIVEN_TRIGGERS, Runner, set_problem
+from station.run.engine import CAPTURE_BY, Runner
+from station.run.readings import DEVICE_DRIVEN_TRIGGERS, set_problem
 from station.run.setup import (
     PortSetup,
     SessionSetup,

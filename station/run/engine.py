@@ -47,11 +47,8 @@ journal's own sentence (:attr:`Runner.failure`).
 
 from __future__ import annotations
 
-import contextlib
-import math
 import queue
 import threading
-import time
 from collections import deque
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
@@ -59,49 +56,40 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 from station import verdicts
-from station.analysis.rules import rule_name
 from station.errors import StationError
-from station.instruments.gauge import unit_mismatch
+from station.run.alarms import AlarmJournal
+from station.run.intake import InstrumentIntake
+from station.run.readings import cycle_times
+from station.run.services import StepServices
 from station.run.setup import SessionSetup, resume_setup, unroll
 from station.run.state import (
     Action,
     CycleOutcome,
     CycleRecord,
     Listener,
-    MessageLevel,
     OperatorMessage,
-    PortState,
-    Progress,
     RunnerNotice,
     RunnerState,
     RunnerStatus,
     StepView,
-    StrokeOutcome,
 )
 from station.run.steps import handler_for
-from station.run.steps.base import PlanItem, StepHandler
+from station.run.steps.base import PlanItem
 from station.session.alarms import (
     RecordedAlarm,
-    ack_fields,
-    acknowledgement,
-    recorded_alarm,
     recorded_alarms,
 )
 from station.session.header import analysis_config
 from station.session.journal import SessionWriter
-from station.session.model import Session, event_seconds
+from station.session.model import Session
 
 if TYPE_CHECKING:
-    from station.instruments.gauge import CaptureResult, PortStatus, Subscription
+    from station.instruments.gauge import CaptureResult, Subscription
 
 CAPTURE_BY = "station capture"
 """The ``by`` recorded when the headless command confirms a step itself."""
 
 _MESSAGES_KEPT = 20
-
-DEVICE_DRIVEN_TRIGGERS = ("push", "arrival")
-"""Triggers where the devices (a DATA press, the robot's arrival) decide when a set is taken:
-the engine records the sets they send instead of polling."""
 
 
 class Gauges(Protocol):
@@ -143,7 +131,7 @@ class Journal(Protocol):
     def close(self) -> None: ...
 
 
-class Runner:
+class Runner(InstrumentIntake, AlarmJournal, StepServices):
     """The state machine of one session; build it with :meth:`start` or :meth:`resume`.
 
     ``gauges`` is a started gauge set (:func:`~station.run.setup.open_gauges`); the engine
@@ -336,152 +324,6 @@ class Runner:
 
     # -- what the instruments send ----------------------------------------------------------
 
-    def _attach(self, moment: str) -> None:
-        """Start the intake thread, subscribe to the gauges' sets and port changes (cancelled
-        by :meth:`_close`) and record how each line stands now. On failure everything is undone
-        and the file closed."""
-        self._intake = queue.SimpleQueue()
-        self._intake_thread = threading.Thread(
-            target=self._take_in, name="runner intake", daemon=True
-        )
-        self._intake_thread.start()
-        try:
-            for reader in getattr(self.gauges, "readers", ()):
-                self._port_states[reader.url] = reader.state
-            self._subscription = self.gauges.subscribe(
-                on_set=self._on_set if self.gauges.trigger in DEVICE_DRIVEN_TRIGGERS else None,
-                on_status=self._on_port_status,
-                on_arrival=self._on_arrival if self.gauges.trigger == "arrival" else None,
-            )
-            with self.lock:
-                # The file says how each line stood when the session (re)started; changes
-                # follow.
-                for url, state in self._port_states.items():
-                    self.append("instrument", port=url, state=state, message=moment)
-                self._step_entered()
-        except BaseException:
-            with self.lock:
-                self._close()
-            raise
-
-    def _on_port_status(self, status: PortStatus) -> None:
-        """A port's state changed, on its reader's thread: handed to the intake thread, which
-        writes the ``instrument`` event (the reader never waits for the disk)."""
-        if self._intake is not None:
-            self._intake.put(("status", status))
-
-    def _record_port_status(self, status: PortStatus) -> None:
-        """The intake side of :meth:`_on_port_status`. Lock held."""
-        if status.state == self._port_states.get(status.port):
-            return
-        self._port_states[status.port] = status.state
-        if self.status in ("running", "paused") and status.state in (
-            "connected",
-            "disconnected",
-        ):
-            self.append("instrument", port=status.port, state=status.state, message=status.message)
-            level: MessageLevel = "info" if status.state == "connected" else "warning"
-            self.say(level, f"{status.port}: {status.state} ({status.message})")
-
-    def _on_arrival(self, event: Any) -> None:
-        """The arrival trigger's news (departed, returned, unsettled), on a reader's thread:
-        handed to the intake thread, which says it (reported, never recorded)."""
-        if self._intake is not None:
-            self._intake.put(("arrival", event))
-
-    def _say_arrival(self, event: Any) -> None:
-        """Say an arrival event: the robot's going and coming as information, a return that
-        did not settle as a warning (no set was taken for it). Lock held."""
-        if self.status not in ("running", "paused"):
-            return
-        if event.kind == "departed":
-            self.say("info", f"The robot left the fixture ({', '.join(event.channels)} away).")
-        elif event.kind == "returned":
-            self.say("info", "The robot returned to the fixture; waiting for it to be still.")
-        elif event.kind == "unsettled":
-            self.say("warning", event.message)
-
-    def arm_trigger(self) -> None:
-        """A step that takes sets became current: with the ``arrival`` trigger, only a
-        departure from now on starts a cycle (a robot already on its way back when the step
-        began is not one). The gauges are armed on the intake thread, without the lock; sets
-        that arrived before are not recorded. Lock held."""
-        if self.setup.trigger != "arrival" or self._intake is None:
-            return
-        self._arm_pending = True
-        self._intake.put(("arm",))
-
-    def _step_entered(self) -> None:
-        """Tell the current step's handler that it became current. Lock held."""
-        item = self._item_or_none()
-        if item is not None and self.status == "running":
-            handler_for(item.step.kind).entered(self, item)
-
-    def _on_set(self, result: CaptureResult) -> None:
-        """A completed set the devices sent (push, arrival), on the reader's thread: note which
-        step was current and hand it over, without the engine's lock."""
-        with self._intake_lock:
-            stream = self._stream_queue
-            position, busy = self._position, self.busy
-        if stream is not None:
-            stream.put(result)  # a stream takes every set, in order
-            return
-        if self._intake is not None:
-            self._intake.put(("set", position, busy, result))
-
-    def _take_in(self) -> None:
-        """The intake thread: records queued sets and port changes, in order, until the
-        engine closes."""
-        assert self._intake is not None
-        intake = self._intake
-        while True:
-            queued = intake.get()
-            if queued is None:
-                return
-            if queued[0] == "arm":
-                # Waits on the reader threads (a flush): never under the engine's lock.
-                with contextlib.suppress(StationError):
-                    self.gauges.arm(1.0)
-                with self.lock:
-                    self._armed_at = time.monotonic()
-                    self._arm_pending = False
-                continue
-            with self.lock:
-                if self._writer.closed:
-                    continue  # closed while this waited: the file takes nothing more
-                # A failed write is already the operator's message and the engine's failure.
-                with contextlib.suppress(StationError):
-                    if queued[0] == "status":
-                        self._record_port_status(queued[1])
-                    elif queued[0] == "arrival":
-                        self._say_arrival(queued[1])
-                    else:
-                        self._record_pushed_set(*queued[1:])
-
-    def _record_pushed_set(self, position: int, busy: bool, result: CaptureResult) -> None:
-        """Record a pushed set if the step current when it arrived still is. Lock held."""
-        if busy or self.status != "running" or position != self._position:
-            # A software zero took this set, the session is not running, or the step moved on
-            # since the set arrived.
-            return
-        if result.trigger == "arrival" and (self._arm_pending or result.t_trigger < self._armed_at):
-            return  # the robot came back before this step was armed: not one of its cycles
-        item = self._item_or_none()
-        if item is None or not handler_for(item.step.kind).takes_sets:
-            # Said once per step: a streaming device sends many sets a second, which is
-            # normal, not a fault, so it is said calmly.
-            if self._warned_position != self._position:
-                self._warned_position = self._position
-                self.say(
-                    "info",
-                    "The gauges are sending readings; none is recorded while no capture step "
-                    "is current.",
-                )
-            return
-        self.record_set(result, by="operator", position=position)
-
-    # -- operator actions (the Action kinds) ----------------------------------------------------
-
     def confirm(self, by: str = "operator") -> None:
         """Complete the current step as its handler defines confirming it (a check; a cycles
         step with its minimum; a zero step zeroes). StationError when it cannot be."""
@@ -545,47 +387,6 @@ class Runner:
             self.say("info", f"Cycle {record.cycle} rejected: {reason}.")
             self._notify(self._last_event, analysis=True)
             return record.cycle
-
-    def acknowledge(
-        self,
-        alarm_ref: int,
-        cause: str,
-        text: str | None = None,
-        action: str | None = None,
-        by: str = "operator",
-    ) -> RecordedAlarm:
-        """Acknowledge the alarm event whose ``seq`` is ``alarm_ref`` with ``cause`` (one of
-        the procedure's causes; "other" needs ``text``) and the corrective ``action``: an
-        ``ack`` event, fsynced. Returns the alarm with its acknowledgements. StationError for
-        an unknown alarm or cause, or a closed file."""
-        with self.lock:
-            self.ensure_open()
-            index = next(
-                (i for i, alarm in enumerate(self._alarm_list) if alarm.seq == alarm_ref), None
-            )
-            if index is None:
-                known = ", ".join(f"#{alarm.seq}" for alarm in self._alarm_list) or "none yet"
-                raise StationError(
-                    f"there is no alarm #{alarm_ref} in this session (alarms: {known})"
-                )
-            fields = ack_fields(
-                alarm_ref,
-                cause,
-                causes=self.setup.procedure.causes,
-                text=text or "",
-                action=action or "",
-                by=by,
-            )
-            event = self.append("ack", **fields)
-            alarm = self._alarm_list[index]
-            acknowledged = replace(alarm, acks=(*alarm.acks, acknowledgement(event)))
-            alarms = list(self._alarm_list)
-            alarms[index] = acknowledged
-            self._alarm_list = tuple(alarms)
-            self.say(
-                "info", f"Alarm #{alarm_ref} acknowledged: {acknowledged.acks[-1].describe()}."
-            )
-            return acknowledged
 
     def note(self, text: str, by: str = "operator") -> None:
         """Record the operator's note."""
@@ -754,226 +555,6 @@ class Runner:
     # -- for step handlers ------------------------------------------------------------------
     # Called by the handlers in station/run/steps with the lock held unless said otherwise.
 
-    def handler(self, item: PlanItem) -> StepHandler:
-        """The handler of a plan item's step kind."""
-        return handler_for(item.step.kind)
-
-    def step_state(self, item: PlanItem) -> dict[str, Any]:
-        """A plan item's own mutable state (a handler's counters), kept for the session."""
-        return self._step_states.setdefault(item.key, {})
-
-    @property
-    def devices_pace(self) -> bool:
-        """True when the devices decide when a set is taken (push, arrival)."""
-        return self.setup.trigger in DEVICE_DRIVEN_TRIGGERS
-
-    @property
-    def next_cycle(self) -> int:
-        """The number the next recorded cycle gets."""
-        return self._next_cycle
-
-    def accepted_in(self, item: PlanItem) -> int:
-        """Accepted cycles recorded in a plan item."""
-        return self._accepted_by_step.get(item.key, 0)
-
-    def claim(self) -> None:
-        """Mark a capture, zero or stroke under way, and the step it belongs to: its result
-        is recorded only while that step is still current."""
-        if self.busy:
-            raise StationError("a capture or zero is already under way: wait for it")
-        self.busy = True
-        self._claimed_position = self._position
-
-    def release(self) -> None:
-        """End what :meth:`claim` began."""
-        self.busy = False
-
-    def ensure_open(self) -> None:
-        """StationError when the file takes nothing more (failed, finished, interrupted)."""
-        if self.status == "failed" and self._failure:
-            raise StationError(self._failure)
-        if self.status in ("finished", "interrupted", "failed"):
-            raise StationError(f"the session is {self.status}: {self.path}")
-
-    def ensure_running(self) -> None:
-        """:meth:`ensure_open`, and StationError while captures are paused."""
-        self.ensure_open()
-        if self.status == "paused":
-            raise StationError("capture is paused: resume it first")
-
-    def complete_step(self, item: PlanItem, by: str) -> None:
-        """Write the plan item's ``step`` event and move on."""
-        handler_for(item.step.kind).closing(self, item)
-        self.append(
-            "step",
-            step=item.step.id,
-            placement=item.placement,
-            kind=item.step.kind,
-            action="confirmed",
-            by=by,
-        )
-        self._position += 1
-        self._step_entered()
-        self._notify(None)
-
-    def take_set(self, timeout: float, by: str) -> CycleOutcome:
-        """Take one reading set for the current step (called without the lock): with a trigger
-        the devices drive (push, arrival) wait for the next set, which the intake records;
-        otherwise poll the gauges and record what they give."""
-        with self.lock:
-            if self.setup.trigger in DEVICE_DRIVEN_TRIGGERS:
-                seen = self._outcomes
-                if not self._outcome_ready.wait_for(
-                    lambda: self._outcomes != seen or self.status != "running", timeout
-                ):
-                    outcome = self.refuse(
-                        f"No reading set arrived within {timeout:g} s: "
-                        + (
-                            "press DATA on the gauges (or check the cable)."
-                            if self.setup.trigger == "push"
-                            else "run the robot's playback (or check the cable)."
-                        )
-                    )
-                    return replace(outcome, waited=True)
-                if self.status == "failed":
-                    self.ensure_open()  # raises the failure's own sentence
-                if self.status != "running" or self._last_outcome is None:
-                    return self.refuse(f"The session is {self.status}; nothing recorded.")
-                return self._last_outcome
-            self.claim()
-        try:
-            result = self.gauges.capture(timeout)
-        except BaseException:
-            with self.lock:
-                self.release()
-            raise
-        with self.lock:
-            self.release()
-            return self.record_set(result, by=by, position=self._claimed_position)
-
-    def record_set(
-        self, result: CaptureResult, by: str, position: int | None = None
-    ) -> CycleOutcome:
-        """Hand a reading set to the current step if it takes sets and (``position``) is still
-        the step the set was taken for. Lock held."""
-        if self.status != "running":
-            outcome = self.refuse(
-                f"The session is {self.status}; the reading set was not recorded."
-            )
-        elif position is not None and position != self._position:
-            outcome = self.refuse(
-                "The step changed while the reading set was taken; it was not recorded."
-            )
-        else:
-            item = self._item_or_none()
-            handler = handler_for(item.step.kind) if item is not None else None
-            if item is None or handler is None or not handler.takes_sets:
-                outcome = self.refuse(
-                    "No capture step is current; the reading set was not recorded."
-                )
-            else:
-                outcome = handler.accept_set(self, item, result, by)
-        self._last_outcome = outcome
-        self._outcomes += 1
-        self._outcome_ready.notify_all()
-        return outcome
-
-    def set_problem(self, result: CaptureResult, needed: Sequence[str]) -> str:
-        """Why a reading set cannot be a cycle ('' when it can): a needed channel missing,
-        stale or duplicated, or in another unit than the session's."""
-        return set_problem(result, needed, self.setup.resolved_unit)
-
-    def write_cycle(self, item: PlanItem, readings: Mapping[str, Any], by: str) -> CycleOutcome:
-        """Write a whole reading set as the next cycle of ``item``; the listener hears of it
-        as soon as it is on disk, the live analysis and its alarms follow."""
-        number = self._next_cycle
-        self.append(
-            "reading",
-            notify=False,
-            cycle=number,
-            step=item.step.id,
-            placement=item.placement,
-            by=by,
-            channels={
-                channel: {
-                    "value": reading.value,
-                    "unit": reading.unit,
-                    "raw_value": reading.device_value,
-                    "zero": reading.zero_offset,
-                    "raw": reading.raw,
-                    "t_wall": reading.t_wall,
-                    "t_mono": reading.t_mono,
-                }
-                for channel, reading in readings.items()
-            },
-        )
-        self._next_cycle = number + 1
-        record = CycleRecord(
-            cycle=number,
-            values={channel: float(r.value) for channel, r in readings.items()},
-            step_id=item.step.id,
-            placement=item.placement,
-            resolution=self.setup.resolved_resolution,
-            times=cycle_times(list(readings), self._last_event or {}),
-        )
-        self._cycles.append(record)
-        self._accepted_by_step[item.key] = self._accepted_by_step.get(item.key, 0) + 1
-        self._accepted_count += 1
-        # Acknowledged: the listener hears of the reading as soon as it is on disk, with the
-        # state that includes it (the last-reading line); the live figures and alarms follow.
-        self._notify(self._last_event)
-        self._record_alarms(self._live.add_cycle(record.values, number, record.times), number)
-        self._notify(None, analysis=True)
-        return CycleOutcome(recorded=True, message=record.line(), cycle=record)
-
-    def stroke_recorded(self, outcome: StrokeOutcome) -> None:
-        """A whole stroke is on disk: the live analysis takes it and the listener hears."""
-        with self.lock:
-            self._live.add_stroke(outcome)
-            self._notify(None, analysis=True)
-
-    def refuse(self, message: str) -> CycleOutcome:
-        """A set not recorded, with the operator's sentence."""
-        self.say("warning", message)
-        return CycleOutcome(recorded=False, message=message)
-
-    def open_stream_queue(self) -> queue.SimpleQueue[Any]:
-        """Route every pushed set to a stream under way (in order, none dropped)."""
-        with self._intake_lock:
-            self._stream_queue = queue.SimpleQueue()
-            return self._stream_queue
-
-    def close_stream_queue(self) -> None:
-        """Pushed sets go back to the intake."""
-        with self._intake_lock:
-            self._stream_queue = None
-
-    def append(self, event_type: str, *, notify: bool = True, **fields: Any) -> dict[str, Any]:
-        """Write one event (fsynced when this returns). A failed write marks the engine failed
-        and re-raises the journal's sentence."""
-        fields = {k: v for k, v in fields.items() if v is not None}
-        try:
-            event = self._writer.append(event_type, **fields)
-        except StationError as error:
-            if self._writer.closed:
-                self.status = "failed"
-                self._failure = error.message
-                self.say("error", error.message)
-                self._outcome_ready.notify_all()
-            raise
-        self._last_event = event
-        if notify:
-            self._notify(event)
-        return event
-
-    def say(self, level: MessageLevel, text: str) -> None:
-        """An operator message (kept, and sent to the listener)."""
-        message = OperatorMessage(level, text)
-        self._messages.append(message)
-        self._tell(RunnerNotice(None, self.state(), message))
-
-    # -- internals --------------------------------------------------------------------------
-
     def _rebuild_live(self, session: Session | None = None) -> None:
         """Recount the accepted cycles and rebuild the live analysis from them (after a
         reject; on resume with the session's own record of what is not a cycle)."""
@@ -1030,50 +611,6 @@ class Runner:
             self._views_position = self._position
         return self._views
 
-    def _instrument_states(self) -> tuple[PortState, ...]:
-        return tuple(
-            PortState(
-                url=reader.url,
-                status=reader.state,
-                rejected_frames=reader.rejected_count,
-                detail=reader.last_message,
-            )
-            for reader in getattr(self.gauges, "readers", ())
-        )
-
-    def _record_alarms(self, updates: Mapping[str, Any], raised_at: int) -> None:
-        """Write ``alarm`` events for the alarms cycle ``raised_at`` raised (the windows it
-        completes, O(1))."""
-        for channel, update in updates.items():
-            for alarm in update.alarms:
-                self._record_alarm(channel, alarm, raised_at)
-
-    def _record_alarm(self, channel: str, alarm: Any, raised_at: int) -> None:
-        # The live analysis is fed each set with its cycle number: its alarms name cycles.
-        cycles = list(alarm.cycles)
-        if not cycles:
-            return
-        flagged = self._alarm_flagged.setdefault((channel, alarm.rule), set())
-        known = not flagged.isdisjoint(cycles)
-        flagged.update(cycles)
-        if known:
-            return
-        # The fields of LiveAlarm.event_fields: what a replay of the file gives back.
-        event = self.append(
-            "alarm",
-            channel=channel,
-            rule=alarm.rule,
-            rule_name=rule_name(alarm.rule),
-            points=list(alarm.points),
-            cycles=cycles,
-            text=alarm.text,
-            raised_at=raised_at,
-            live=True,
-        )
-        self._alarm_count += 1
-        self._alarm_list = (*self._alarm_list, recorded_alarm(event))
-        self.say("warning", f"{channel}: {rule_name(alarm.rule)}: {alarm.text}")
-
     def _close(self) -> None:
         """Close the file and let go of the gauges (the subscription is cancelled, so a gauge
         set resumed on again and again never keeps dead engines) and end the intake thread."""
@@ -1100,39 +637,4 @@ class Runner:
             self._messages.append(OperatorMessage("error", f"the display failed: {error!r}"))
 
 
-def cycle_times(channels: Sequence[str], event: Mapping[str, Any]) -> dict[str, float] | None:
-    """The time of a cycle's readings for the drift's trend: its ``reading`` event's ``t``
-    (what the session file's analysis and its exports use), for every channel."""
-    stamp = event_seconds(str(event.get("t") or ""))
-    return None if math.isnan(stamp) else dict.fromkeys(channels, stamp)
-
-
-def set_problem(result: CaptureResult, needed: Sequence[str], unit: str) -> str:
-    """Why a reading set cannot be a cycle ('' when it can): a needed channel missing, stale
-    or duplicated, or in another unit than the session's."""
-    problems = []
-    missing = [c for c in needed if c not in result.readings]
-    down = set(getattr(result, "disconnected", ()))
-    stale = [c for c in missing if c in result.stale and c not in down]
-    # A channel whose port is down is explained by the port's own sentence (in errors).
-    absent = [c for c in missing if c not in stale and c not in down]
-    if absent:
-        problems.append("no reading from " + ", ".join(absent))
-    if stale:
-        problems.append("only readings from before the trigger on " + ", ".join(stale))
-    duplicated = [c for c in needed if c in result.duplicated]
-    if duplicated:
-        problems.append("more than one reading from " + ", ".join(duplicated))
-    mismatch = unit_mismatch(result.readings, needed, unit)
-    if mismatch:
-        problems.append(mismatch)
-    if missing and result.errors:
-        # A port's sentence may end in a full stop already; this one ends the whole list.
-        problems.extend(error.rstrip(". ") for error in result.errors)
-    elif down & set(missing):
-        unexplained = [c for c in missing if c in down]
-        problems.append(f"the port of {', '.join(unexplained)} is disconnected (reconnecting...)")
-    return "; ".join(problems) + "." if problems else ""
-
-
-__all__ = ["CAPTURE_BY", "Gauges", "Journal", "Progress", "Runner", "set_problem"]
+__all__ = ["CAPTURE_BY", "Gauges", "Journal", "Runner"]

@@ -390,6 +390,7 @@ def test_capture_summary_of_nine_cycles_is_provisional(simulator, tmp_path):
         "capture", "--procedure", "cycles-only", "--procedures", str(folder),
         "--port", simulator.url, "--protocol", "mitutoyo", "--robot", "R9",
         "--sessions", str(tmp_path / "s"), "--cycles", "9", "--limit", "x=-0.002:0.002",
+        "--every", "0.01",
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     verdicts = [line for line in done.stdout.splitlines() if line.startswith("VERDICT:")]
