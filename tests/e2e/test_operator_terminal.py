@@ -192,6 +192,12 @@ def test_demo_autopilot_count_5_ends_on_the_verdict(tmp_path: Path, procedure: s
     try:
         screen = pane.wait_for("Verdict:", timeout=180)
         verdict = next(line for line in screen.splitlines() if "Verdict:" in line)
-        assert verdict.split("Verdict:")[1].split()[0] in ("CAPABLE", "NOT", "UNDEFINED")
+        # Five cycles are a trial run: the verdict is a word, provisional below the minimum.
+        assert verdict.split("Verdict:")[1].split()[0] in (
+            "CAPABLE",
+            "NOT",
+            "UNDEFINED",
+            "PROVISIONAL:",
+        )
     finally:
         pane.close()

@@ -285,8 +285,9 @@ def test_a_procedure_with_an_infinite_nominal_is_refused_on_load(tmp_path: Path)
 
 @pytest.mark.parametrize(
     ("arguments", "words"),
-    [(["--count", "5"], ("at least 25",)), (["--procedure", "nope"], ("no procedure 'nope'",))],
-    ids=["count 5", "procedure nope"],
+    # (`--count 5` is a trial run now, issue 13: it ends on a provisional verdict.)
+    [(["--count", "1"], ("at least 2",)), (["--procedure", "nope"], ("no procedure 'nope'",))],
+    ids=["count 1", "procedure nope"],
 )
 def test_demo_refuses_what_the_tui_would_wait_on_forever(tmp_path, arguments, words) -> None:
     result = station(

@@ -24,6 +24,17 @@ def fixture_pty() -> Iterator[DemoFixture]:
         fixture.stop()
 
 
+@pytest.fixture
+def alarming_fixture() -> Iterator[DemoFixture]:
+    """The demo's fixture with a seed whose first 30 cycles raise live alarms once the
+    control limits freeze (after 25 cycles)."""
+    fixture = start_demo_fixture(42)
+    try:
+        yield fixture
+    finally:
+        fixture.stop()
+
+
 async def wait_until(pilot, condition: Callable[[], object], timeout: float = 10.0) -> None:
     """Let the app run until ``condition()`` is true; fail after ``timeout`` seconds."""
     deadline = time.monotonic() + timeout

@@ -152,18 +152,22 @@ async def test_no_color_summary_verdict_reads_by_attribute(
         await pilot.press("enter")
         await tui.wait_until(pilot, lambda: isinstance(app.screen, SummaryScreen))
         await pilot.pause(0.2)
-        verdicts = _segments_of(app, "CAPABLE")
+        # The first saved session may still be provisional (too few strokes): either word.
+        drawn = _screen_text(app)
+        verdicts = _segments_of(app, "CAPABLE" if "CAPABLE" in drawn else "PROVISIONAL")
         for segment in verdicts:
             assert_reads_without_colour(segment)
         # NOT CAPABLE stands apart from CAPABLE by more than a shade: reverse video.
+        assert verdicts, _screen_text(app)
         for segment in verdicts:
             if "NOT CAPABLE" in segment.text:
                 assert segment.style.reverse
 
 
 async def test_no_color_alarm_lines_read_by_attribute(
-    tmp_path: Path, monkeypatch, fixture_pty, tui
+    tmp_path: Path, monkeypatch, alarming_fixture, tui
 ) -> None:
+    fixture_pty = alarming_fixture
     from station.tui.widgets.alarm_log import AlarmLog
 
     monkeypatch.setenv("NO_COLOR", "1")
@@ -173,7 +177,7 @@ async def test_no_color_alarm_lines_read_by_attribute(
         await pilot.press("f2")
         await tui.walk_checklist(pilot)
         log = app.screen.query_one(AlarmLog)
-        for _ in range(25):
+        for _ in range(30):  # live alarms come once the limits freeze (after 25 cycles)
             await tui.capture_one(pilot)
             if "⚠" in str(log.render()):
                 break
@@ -691,8 +695,9 @@ async def test_linearity_one_sided_limits_are_explained_on_screen(
         assert "one-sided: upper limit 0.00200 in only" in verdict, verdict
 
 
-async def test_long_alarm_texts_open_in_full(tmp_path: Path, fixture_pty, tui) -> None:
+async def test_long_alarm_texts_open_in_full(tmp_path: Path, alarming_fixture, tui) -> None:
     """The alarm log cuts each alarm to one line; ``m`` shows them in full."""
+    fixture_pty = alarming_fixture
     from station.tui.screens.dialogs import FullTextScreen
     from station.tui.widgets.alarm_log import AlarmLog
 
@@ -702,7 +707,7 @@ async def test_long_alarm_texts_open_in_full(tmp_path: Path, fixture_pty, tui) -
         await pilot.press("f2")
         await tui.walk_checklist(pilot)
         log = app.screen.query_one(AlarmLog)
-        for _ in range(25):
+        for _ in range(30):  # live alarms come once the limits freeze (after 25 cycles)
             await tui.capture_one(pilot)
             if "⚠" in str(log.render()):
                 break

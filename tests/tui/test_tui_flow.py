@@ -14,16 +14,13 @@ import math
 import re
 import subprocess
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 
-import pytest
 from textual.widgets import Footer, Input, Static
 
 from station.analysis.summary import to_json
 from station.session.model import load_session
 from station.tui.app import StationApp, StationConfig
-from station.tui.instruments import DemoFixture, start_demo_fixture
 from station.tui.screens.alarms import AckDialog, AlarmsScreen
 from station.tui.screens.dashboard import DashboardScreen
 from station.tui.screens.home import HomeScreen
@@ -53,17 +50,6 @@ def _same(a: object, b: object, path: str = "") -> None:
 
 def _text(app: StationApp, selector: str) -> str:
     return str(app.screen.query_one(selector, Static).render())
-
-
-@pytest.fixture
-def alarming_fixture() -> Iterator[DemoFixture]:
-    """The demo's fixture with a seed whose first 30 cycles raise live alarms once the
-    control limits freeze (the walk acknowledges one)."""
-    fixture = start_demo_fixture(42)
-    try:
-        yield fixture
-    finally:
-        fixture.stop()
 
 
 async def test_full_repeatability_session(tmp_path: Path, alarming_fixture, tui) -> None:

@@ -40,6 +40,9 @@ async def test_out_of_spec_flagged_live_and_nine_cycles_are_provisional(
         # A tolerance on x tighter than its spread: some readings fall outside.
         app.screen.query_one("#limits-x", Input).value = "±0.0002"
         await pilot.press("f2")
+        # Two gauge steps either side is implausibly tight: the set-up asks; yes, on purpose.
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, ConfirmScreen))
+        await pilot.press("y")
         await tui.walk_checklist(pilot)
         assert isinstance(app.screen, DashboardScreen)
         flagged = 0

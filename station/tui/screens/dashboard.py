@@ -509,7 +509,11 @@ class DashboardScreen(Screen[None]):
         if view is not None:
             if view.message is not None:
                 lines.append(f"Newest message: {view.message.text}")
-            lines.extend(alarm_lines(view.analyses, view.cycle_numbers))
+            # The same alarms, in the same words, as the log shows them cut to a line.
+            if view.alarms is not None:
+                lines.extend(recorded_alarm_lines(view.alarms))
+            else:
+                lines.extend(alarm_lines(view.analyses, view.cycle_numbers))
         self.app.push_screen(FullTextScreen("Messages and alarms in full", lines))
 
     def action_back(self) -> None:

@@ -130,8 +130,8 @@ class ReviewScreen(Screen[None]):
     @work(thread=True, group="review-verdicts", exclusive=True, exit_on_error=False)
     def _work_out_verdicts(self, paths: list[Path]) -> None:
         """Thread worker: each finished session's overall verdict, as the summary says it."""
+        from station.text import overall_verdict, verdict_word
         from station.tui.screens.summary import SummaryView
-        from station.tui.widgets.figures import overall_verdict, verdict_word
 
         for path in paths:
             try:
