@@ -192,7 +192,9 @@ def header_baseline(robot: str, procedure: str, unit: str) -> dict[str, Any] | N
     alarms test against, and which session they came from), or None when it has none for this
     procedure and unit (a baseline of another procedure or unit says nothing here)."""
     record = baseline_for(robot)
-    if record is None or record.get("procedure") != procedure or record.get("unit") != unit:
+    recorded = record.get("procedure") if record is not None else None
+    recorded_id = recorded.get("id") if isinstance(recorded, dict) else recorded
+    if record is None or recorded_id != procedure or record.get("unit") != unit:
         return None
     anchor = str(record.get("anchor") or "")
     source = f"baseline of session {record.get('session')} ({record.get('date')})"

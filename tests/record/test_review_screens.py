@@ -54,3 +54,34 @@ async def test_history_and_compare_from_the_review_list(sessions):
         compared = _text(app)
         assert "A (before)" in compared and "B (after)" in compared, compared
         assert "y moved" in compared, compared
+
+
+async def test_a_tui_session_of_a_robot_with_a_baseline_records_it(sessions, tmp_path):
+    """Phase II from the robot's baseline: a session the TUI starts for that robot and
+    procedure records the baseline in its header (its live alarms test against it)."""
+    from station.record.baseline import store_baseline
+    from station.tui.instruments import start_demo_fixture
+
+    filed = write_repeatability(sessions, robot="R1", seed=4, alarm=False, reject=None)
+    store_baseline("R1", filed)
+    fixture = start_demo_fixture(1990)
+    (tmp_path / "new").mkdir()
+    app = StationApp(StationConfig(sessions_dir=tmp_path / "new", sessions_reason="test"))
+    try:
+        async with app.run_test(size=(80, 24)) as pilot:
+            await _until(pilot, lambda: isinstance(app.screen, HomeScreen))
+            await pilot.press("n")
+            await _until(pilot, lambda: app.screen.query("#port"))
+            await pilot.pause()
+            await pilot.press(*"R1")
+            app.screen.query_one("#port").value = fixture.url
+            app.screen.query_one("#map").value = "1=x,2=y,3=z"
+            app.screen.query_one("#trigger").value = "poll"
+            await pilot.press("f2")
+            await _until(pilot, lambda: app.runner is not None)
+            recorded = app.runner.header.get("baseline")
+            assert recorded and set(recorded["limits"]) == {"x", "y", "z"}, recorded
+            assert recorded["session"] and recorded["anchor"]
+            app.interrupt_session("test over")
+    finally:
+        fixture.stop()

@@ -26,6 +26,7 @@ from textual.widgets import Button, Footer, Input, Label, Select, Static
 
 from station.errors import StationError
 from station.plain import plain
+from station.record.baseline import header_baseline
 from station.tui.app import PortNotOpen
 from station.tui.messages import ConnectionTested
 from station.tui.remedies import explained
@@ -637,6 +638,10 @@ class SetupScreen(Screen[None]):
                 resolution=resolution,
                 limits=limits,
                 **{count.setup_key: cycles},
+                # Live alarms test against the robot's baseline for this procedure and unit.
+                baseline=header_baseline(
+                    robot, procedure.id, self._value("unit") or procedure.unit
+                ),
             )
         except StationError as error:
             self._say("setup", explained(error))
