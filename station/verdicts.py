@@ -136,6 +136,9 @@ class AnalysisKind:
     json: Callable[[Any], dict[str, Any]] | None = None
     count: Callable[[Any], str] | None = None
     """What a session measured, in words (``7 strokes``); None: its cycles."""
+    export_layout: str = "tidy"
+    """The CSV layout ``station export`` writes by default: ``tidy`` (a row per reading) or
+    ``wide`` (the table this kind's analysis reads back: strokes, placements)."""
     header_fields: Callable[[Mapping[str, Any]], dict[str, Any]] | None = None
     """Fields a new session's header records for this kind, given the header's other fields
     (the gauge checks that cover a repeatability session's gauges)."""
@@ -721,6 +724,7 @@ register(
         json_key="linearity",
         json=linearity_json,
         count=lambda result: f"{len(result.strokes)} strokes",
+        export_layout="wide",
     )
 )
 register(
@@ -737,6 +741,7 @@ register(
         json_key="accuracy",
         json=accuracy_json,
         count=lambda result: f"{len(result.placements)} placements",
+        export_layout="wide",
     )
 )
 

@@ -48,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
     from station.record.export import export_table
     from station.session.durable import replace_durably
     from station.session.model import load_session
-    from station.verdicts import session_analysis
+    from station.verdicts import kind_of, session_analysis
 
     session = load_session(args.file, recover=False)
     if session.torn is not None:
@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
     kind = session_analysis(session)
     layout = args.layout
     if layout == "auto":
-        layout = "wide" if kind in ("linearity", "relative_accuracy") else "tidy"
+        layout = kind_of(kind).export_layout
 
     if not args.output:
         export_table(session, sys.stdout, layout, kind)
