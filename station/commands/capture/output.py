@@ -3,6 +3,7 @@ the questions for the alarms' causes at a terminal, and the summary."""
 
 from __future__ import annotations
 
+import os
 import select
 import sys
 from pathlib import Path
@@ -12,6 +13,38 @@ from station.commands._remedies import CLI_REMEDIES
 from station.commands.capture.walker import BY
 from station.errors import StationError
 from station.text import zero_taken, zero_text
+
+
+class TypedLines:
+    """Lines typed at a terminal, read straight from its file descriptor.
+
+    select() sees only what the kernel still holds: a buffered ``readline`` may already have
+    taken in the lines an operator typed ahead, and the next select would then wait for input
+    that has long arrived. Reading the descriptor keeps the two in step."""
+
+    def __init__(self, fd: int) -> None:
+        self.fd = fd
+        self._pending = b""
+
+    def readline(self, stop: Any = lambda: False) -> str | None:
+        """The next line without its newline; None at the end of input or once ``stop()``
+        says so (polled every 0.1 s: a signal is only recorded by the command's handler, and
+        must still end the questions)."""
+        while b"\n" not in self._pending:
+            if stop():
+                return None
+            if not select.select([self.fd], [], [], 0.1)[0]:
+                continue
+            try:
+                chunk = os.read(self.fd, 4096)
+            except OSError:  # the terminal hung up
+                chunk = b""
+            if not chunk:
+                last, self._pending = self._pending, b""
+                return last.decode(errors="replace") if last else None
+            self._pending += chunk
+        line, _, self._pending = self._pending.partition(b"\n")
+        return line.decode(errors="replace")
 
 
 class Printer:
@@ -98,15 +131,12 @@ def acknowledge_at_terminal(
         flush=True,
     )
 
+    typed = TypedLines(stdin.fileno())
+
     def ask(prompt: str) -> str | None:
         print(prompt, end="", file=out, flush=True)
-        # Wait in short steps: a signal (Ctrl-C) is only recorded by the command's handler,
-        # and must still end the questions.
-        while not select.select([stdin], [], [], 0.1)[0]:
-            if stop():
-                return None
-        line = stdin.readline()
-        return None if not line or stop() else line.strip()
+        line = typed.readline(stop)
+        return None if line is None or stop() else line.strip()
 
     done = 0
     for alarm in pending:
