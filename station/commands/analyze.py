@@ -157,7 +157,7 @@ def parse_limit(text: str) -> tuple[str, float | None, float | None]:
 
 def is_session_file(path: Path) -> bool:
     """True when the file begins like a station session file (or it is named .jsonl)."""
-    from station.session.model import looks_like_session
+    from station.session.lines import looks_like_session
 
     if path.suffix.lower() == ".jsonl":
         return True
