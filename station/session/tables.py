@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import csv
 import re
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -271,8 +272,6 @@ def _read_tidy(
 
 
 def _load_rows(lines: Any, columns: int) -> np.ndarray:
-    import warnings
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # "input contained no data" for a header-only file
         data = np.loadtxt(
