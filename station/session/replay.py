@@ -4,7 +4,8 @@
 to: the cycles and their readings, rejects, notes, alarms, inputs, streamed points and the
 session's status. The writer checks every event with it before writing, and the loader replays
 a file with it, so a file the writer produced always loads. The table :data:`_EVENT_CHECKS`
-holds one check per event type.
+holds one check per event type. Like the model, it loads numpy only when arrays are asked for
+(:meth:`SampleBatch.as_arrays`).
 """
 
 from __future__ import annotations
