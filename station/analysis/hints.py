@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from statistics import NormalDist
 
 from station.analysis.capability import Capability, SpecLimits
 from station.analysis.descriptive import Descriptive
@@ -52,11 +53,9 @@ def t_quantile(p: float, degrees: int) -> float:
     Cornish-Fisher series in 1/degrees (Abramowitz & Stegun 26.7.5, four terms), exact to
     double precision there and without loading scipy for a large file."""
     if degrees < _T_SERIES_FROM:
-        from scipy.special import stdtrit
+        from scipy.special import stdtrit  # on first use: see README, Development
 
         return float(stdtrit(degrees, p))
-    from statistics import NormalDist
-
     z = NormalDist().inv_cdf(p)
     g1 = (z**3 + z) / 4
     g2 = (5 * z**5 + 16 * z**3 + 3 * z) / 96

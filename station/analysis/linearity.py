@@ -32,18 +32,24 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+import numpy as np
+
+from station.analysis.capability import SpecLimits
 from station.analysis.strokes import (
     DIRECTIONS,
     StrokeProfile,
 )
+from station.analysis.summary import (
+    Analysis,
+    AnalysisConfig,
+    ChannelAnalysis,
+    _number,
+    analyze_channel,
+    channel_to_json,
+)
 from station.errors import StationError
-
-if TYPE_CHECKING:
-    import numpy as np
-
-    from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis
 
 #: The indicator channels of the linearity set-up, and the scale.
 INDICATORS = ("h", "v")
@@ -71,8 +77,6 @@ class Straightness:
 
 
 def _profile(s: Any, d: Any) -> tuple[np.ndarray, np.ndarray]:
-    import numpy as np
-
     s = np.asarray(s, dtype=float).ravel()
     d = np.asarray(d, dtype=float).ravel()
     if s.shape != d.shape:
@@ -93,8 +97,6 @@ def _profile(s: Any, d: Any) -> tuple[np.ndarray, np.ndarray]:
 
 def _hull_chain(points: np.ndarray) -> np.ndarray:
     """One monotone chain (Andrew): the lower hull of points sorted by x, then y."""
-    import numpy as np
-
     chain: list[int] = []
     for i in range(len(points)):
         while len(chain) >= 2:
@@ -110,8 +112,6 @@ def _hull_chain(points: np.ndarray) -> np.ndarray:
 
 def convex_hull(s: np.ndarray, d: np.ndarray) -> np.ndarray:
     """The vertices of the convex hull of the points (s, d), as an (m, 2) array."""
-    import numpy as np
-
     points = np.unique(np.column_stack([s, d]), axis=0)  # sorted by s, then d
     if len(points) <= 2:
         return points
@@ -131,8 +131,6 @@ def minimum_zone(s: Any, d: Any) -> tuple[float, tuple[float, float]]:
     Exact: the width w(b) is convex in b with breaks only at hull-edge slopes; the minimum is at
     one of them, found by binary search on the sorted slopes (w evaluated on the hull vertices).
     """
-    import numpy as np
-
     s, d = _profile(s, d)
     hull = convex_hull(s, d)
     edges = np.diff(np.concatenate([hull, hull[:1]]), axis=0)
@@ -156,8 +154,6 @@ def minimum_zone(s: Any, d: Any) -> tuple[float, tuple[float, float]]:
 
 def least_squares_line(s: Any, d: Any) -> tuple[float, float]:
     """The least-squares line d = a + b·s, as ``(a, b)``."""
-    import numpy as np
-
     s, d = _profile(s, d)
     s_mean, d_mean = float(s.mean()), float(d.mean())
     span = float(np.ptp(s))
@@ -222,8 +218,6 @@ def path_repeatability(
     Each stroke contributes the mean of its points in a bin (so strokes sampled at different
     positions or rates weigh the same).
     """
-    import numpy as np
-
     pairs = [(np.asarray(s, dtype=float), np.asarray(d, dtype=float)) for s, d in profiles]
     if isinstance(bins, int):
         if bins < 1:
@@ -326,9 +320,6 @@ class LinearityAnalysis:
 def _straightness_config(
     config: AnalysisConfig | None, channels: Sequence[str], tolerance: float | None
 ) -> AnalysisConfig:
-    from station.analysis.capability import SpecLimits
-    from station.analysis.summary import AnalysisConfig
-
     base = config or AnalysisConfig()
     limits = {} if tolerance is None else {c: SpecLimits(usl=tolerance) for c in channels}
     # The straightness is a width, never negative: its nominal (the ideal) is 0.
@@ -352,10 +343,6 @@ def analyze_linearity(
     ``config`` supplies the resolution, unit, rule set and threshold (its limits are replaced
     by the tolerance).
     """
-    import numpy as np
-
-    from station.analysis.summary import analyze_channel
-
     if not profiles:
         raise StationError(
             "no complete stroke along the bar: the scale must travel from one end to the other."
@@ -430,18 +417,10 @@ def analyze_linearity(
     )
 
 
-def _number(value: float | None) -> float | None:
-    from station.analysis.summary import _number as json_number
-
-    return json_number(value)
-
-
 def linearity_json(result: LinearityAnalysis) -> dict[str, Any]:
     """The ``"linearity"`` document of ``station analyze --json`` (straightness in the readings'
     unit; ``h.ls``/``h.mz`` at the top are the largest over strokes; ``path_repeatability`` per
     channel is the largest 3·s along the bar)."""
-    from station.analysis.summary import channel_to_json
-
     channels = result.channels
     document: dict[str, Any] = {
         c: {"ls": _number(result.ls[c]), "mz": _number(result.mz[c])} for c in channels
@@ -537,8 +516,6 @@ def linearity_summary(result: LinearityAnalysis) -> Analysis:
     """An :class:`~station.analysis.summary.Analysis` whose channels are the per-stroke MZ
     straightness of each indicator (what ``station analyze`` and a verdict judge), with the
     linearity hints instead of the repeatability ones (an offset from 0 is no fault here)."""
-    from station.analysis.summary import Analysis
-
     named = {
         c: replace(judged, name=f"{c} straightness (MZ, one reading per stroke)")
         for c, judged in result.judged.items()

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 
 from station.analysis.capability import Capability, SpecLimits
 from station.analysis.descriptive import Histogram
+from station.analysis.diagnostics import p_phrase
 from station.analysis.rules import number_list, rule_name
 from station.analysis.spatial import Spatial
 from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis
@@ -176,8 +177,6 @@ def _capability_lines(
 def format_diagnostics(channel: ChannelAnalysis, decimals: int, width: int = 80) -> list[str]:
     """Normality (and the percentile indices when it is rejected), lag-1 autocorrelation with
     the within- and overall-sigma indices side by side, and drift (trend and EWMA)."""
-    from station.analysis.diagnostics import p_phrase
-
     lines: list[str] = []
     normal = channel.normality
     if normal is not None:

@@ -142,7 +142,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def is_session_file(path: Path) -> bool:
     """True when the file begins like a station session file (or it is named .jsonl)."""
-    from station.session.model import looks_like_session
+    from station.session.lines import looks_like_session
 
     if path.suffix.lower() == ".jsonl":
         return True
