@@ -9,6 +9,7 @@ FILE --json`` gives the figures the summary showed.
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 import time
@@ -206,8 +207,12 @@ async def test_linearity_through_the_tui(tmp_path: Path, lab: DemoLab, tui) -> N
         await pilot.pause(0.3)
         assert "3 of 3 strokes done" in text_of(app, "#dash-title")
         assert "Press f to finish" in text_of(app, "#dash-prompt")
+        # Finding 9: one number format on the screen (the plot's position axis read "s 0.00").
+        assert tui.odd_figures(tui.screen_text(app)) == [], tui.screen_text(app)
         plot = str(dashboard.query_one("#stroke-plot").render())
         assert "h − LS line" in plot and "•" in plot
+        # The position along the bar at the figures' decimals too (it read "s 0.00").
+        assert re.search(r"s -?\d+\.\d{5} +-?\d+\.\d{5}$", plot.splitlines()[-1].rstrip()), plot
         chart = str(dashboard.query_one("#stroke-chart").render())
         assert "stroke " in chart and "CL" in chart
         live = [

@@ -22,12 +22,12 @@ from textual.screen import Screen
 from textual.widgets import Footer, Static
 
 from station.errors import StationError
+from station.text import format_figure
 from station.tui.messages import CaptureFinished
 from station.tui.remedies import explained
 from station.tui.text import shown, shown_line
 from station.tui.widgets.alarm_log import AlarmLog, alarm_lines, recorded_alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
-from station.tui.widgets.figures import decimals_for
 from station.tui.widgets.histogram import HistogramView, histogram_data
 from station.tui.widgets.instrument_status import InstrumentStatus, status_text
 from station.tui.widgets.stats_panel import StatsPanel, StatsRows
@@ -135,16 +135,14 @@ class DashboardView:
 
 
 def zero_line(zero: Mapping[str, Any], resolution: float | None) -> str:
-    """The zero in force in one compact line: ``zero x +0.0003 y -0.0001 z +0.0002 (5
-    readings)``; '' before any zero."""
+    """The zero in force in one compact line: ``zero x +0.00030 y -0.00010 z +0.00020 (5
+    readings)`` (at the table's decimals); '' before any zero."""
     if not zero:
         return ""
-    from station.text import format_value
-
     parts = [
         f"{channel} device"
         if spec.get("method") == "device"
-        else f"{channel} {format_value(spec.get('offset'), resolution)}"
+        else f"{channel} {format_figure(spec.get('offset'), resolution)}"
         for channel, spec in zero.items()
     ]
     counts = {spec.get("n") for spec in zero.values()}
@@ -262,7 +260,7 @@ class DashboardScreen(Screen[None]):
                 channels=view.channels,
                 analyses=view.analyses,
                 last=view.last,
-                decimals=decimals_for(view.resolution),
+                resolution=view.resolution,
                 unit=view.unit,
                 selected=self.selected,
                 flags=view.flags,
@@ -272,11 +270,10 @@ class DashboardScreen(Screen[None]):
     def draw(self, view: DashboardView) -> None:
         """Put ``view`` on screen."""
         self._draw_text(view)
-        decimals = decimals_for(view.resolution)
         selected = view.analyses.get(self.selected)
-        self.query_one(HistogramView).show(histogram_data(selected, decimals))
+        self.query_one(HistogramView).show(histogram_data(selected, view.resolution))
         self.query_one(ControlChartView).show(
-            chart_data(selected, list(view.cycle_numbers), decimals)
+            chart_data(selected, list(view.cycle_numbers), view.resolution)
         )
         log = self.query_one(AlarmLog)
         if view.alarms is not None:
@@ -364,7 +361,10 @@ class DashboardScreen(Screen[None]):
             self._say(message.error, "bold red")
         elif message.outcome is not None:
             outcome = message.outcome
-            self._say(outcome.message, "green" if outcome.recorded else "bold red")
+            # A recorded cycle in the table's own format (the engine words it as the gauge
+            # shows it, for the command line).
+            said = outcome.cycle.line(figures=True) if outcome.cycle is not None else None
+            self._say(said or outcome.message, "green" if outcome.recorded else "bold red")
 
     def _in_thread(self, call: Callable[[], Any]) -> None:
         if self._action_busy:

@@ -118,7 +118,7 @@ class ReviewScreen(Screen[None]):
 
     def _verdict_cell(self, summary: Any) -> Text:
         from station.session.store import status_words
-        from station.tui.widgets.figures import VERDICT_STYLES
+        from station.tui.theme import VERDICT_STYLES
 
         if summary.error or summary.status != "finished":
             return shown(status_words(summary))

@@ -31,10 +31,10 @@ from station.errors import StationError
 from station.text import overall_verdict, verdict_word
 from station.tui.remedies import explained
 from station.tui.text import shown
+from station.tui.theme import VERDICT_STYLES
 from station.tui.widgets.alarm_log import AlarmLog, alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.deviation_plot import DeviationData, DeviationPlot, trace
-from station.tui.widgets.figures import VERDICT_STYLES, decimals_for
 from station.tui.widgets.instrument_status import InstrumentStatus
 from station.tui.widgets.stats_panel import StatsPanel, StatsRows
 
@@ -166,7 +166,7 @@ class StrokeDashboardScreen(Screen[None]):
     def show_state(self, state: RunnerState) -> None:
         """Redraw from a runner snapshot and the newest stroke analysis (UI thread)."""
         header = self.app.session_header
-        decimals = decimals_for(header.get("resolution"))
+        resolution = header.get("resolution")
         unit = str(header.get("unit", ""))
         channels = self._channels()
         if self.selected not in channels:
@@ -198,14 +198,14 @@ class StrokeDashboardScreen(Screen[None]):
                 channels=channels,
                 analyses=judged,
                 last=last,
-                decimals=decimals,
+                resolution=resolution,
                 unit=unit,
                 selected=self.selected,
             )
         )
-        self.query_one(DeviationPlot).show(self._deviation_data(decimals, unit))
+        self.query_one(DeviationPlot).show(self._deviation_data(resolution, unit))
         self.query_one(ControlChartView).show(
-            chart_data(judged.get(self.selected), numbers, decimals, label="stroke")
+            chart_data(judged.get(self.selected), numbers, resolution, label="stroke")
         )
         self.query_one(AlarmLog).show(alarm_lines(judged, numbers, label="stroke"))
         self.query_one(InstrumentStatus).show(tuple(state.instruments))
@@ -238,7 +238,7 @@ class StrokeDashboardScreen(Screen[None]):
             text.append("Streaming is stopped. Space streams again; f finishes.")
         return text
 
-    def _deviation_data(self, decimals: int, unit: str) -> DeviationData:
+    def _deviation_data(self, resolution: float | None, unit: str) -> DeviationData:
         channel = self.selected
         earlier: list[Any] = []
         newest = None
@@ -257,7 +257,7 @@ class StrokeDashboardScreen(Screen[None]):
             earlier=tuple(earlier),
             newest=newest,
             current=current,
-            decimals=decimals,
+            resolution=resolution,
             unit=unit,
         )
 

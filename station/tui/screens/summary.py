@@ -26,6 +26,8 @@ from textual.widgets import Footer, Static
 
 from station.errors import StationError
 from station.text import (
+    format_figure,
+    format_index,
     judged_cpk,
     judged_label,
     judged_word,
@@ -33,12 +35,7 @@ from station.text import (
 )
 from station.tui.remedies import explained
 from station.tui.text import shown, shown_line
-from station.tui.widgets.figures import (
-    VERDICT_STYLES,
-    decimals_for,
-    number,
-    ratio,
-)
+from station.tui.theme import VERDICT_STYLES
 
 if TYPE_CHECKING:
     from station.run import RunnerState
@@ -106,10 +103,10 @@ class SummaryView:
         return str(self.header.get("unit", ""))
 
     @property
-    def decimals(self) -> int:
-        """Decimals to show, from the gauge resolution."""
+    def resolution(self) -> float | None:
+        """The gauge's step (every figure is written at one decimal beyond it)."""
         resolution = self.header.get("resolution")
-        return decimals_for(float(resolution) if resolution else None)
+        return float(resolution) if resolution else None
 
 
 REPORT_WIDTH = 74
@@ -141,7 +138,7 @@ def report_text(view: SummaryView) -> Text:
     return shown("\n".join(view.report.lines), no_wrap=True, overflow="crop")
 
 
-def one_sided_sentence(capability: Any, decimals: int, unit: str) -> str:
+def one_sided_sentence(capability: Any, resolution: float | None, unit: str) -> str:
     """Why Cp shows "—" beside a Cpk: a limit on one side only (the straightness of a stroke,
     never below 0, against its tolerance) is judged one-sided; "" for two-sided limits."""
     lsl = getattr(capability, "lsl", None)
@@ -150,11 +147,11 @@ def one_sided_sentence(capability: Any, decimals: int, unit: str) -> str:
         return ""
     if usl is not None:
         return (
-            f"one-sided: upper limit {number(usl, decimals, signed=False)} {unit} only; "
+            f"one-sided: upper limit {format_figure(usl, resolution)} {unit} only; "
             "Cpk = (USL − X̄)/3σ, Cp needs two limits."
         )
     return (
-        f"one-sided: lower limit {number(lsl, decimals)} {unit} only; "
+        f"one-sided: lower limit {format_figure(lsl, resolution)} {unit} only; "
         "Cpk = (X̄ − LSL)/3σ, Cp needs two limits."
     )
 
@@ -185,13 +182,14 @@ def verdict_text(view: SummaryView) -> Text:
         text.append(f"  {shown_line(name, limit=20)}  ", style="bold")
         text.append(f"{judged_label(channel):<11}", style=VERDICT_STYLES.get(word, ""))
         text.append(
-            f" Cp {ratio(capability.cp)}  Cpk {judged_cpk(channel)} (95%: ≥"
-            f"{ratio(capability.cpk_lower)})  X̄ {number(descriptive.mean, view.decimals)}"
-            f"  σ {number(descriptive.sd, view.decimals, signed=False)}\n"
+            f" Cp {format_index(capability.cp)}  Cpk {judged_cpk(channel)} (95%: ≥"
+            f"{format_index(capability.cpk_lower)})  X̄ "
+            f"{format_figure(descriptive.mean, view.resolution)}"
+            f"  σ {format_figure(descriptive.sd, view.resolution, signed=False)}\n"
         )
         if word == "UNDEFINED" and capability.message:
             text.append(f"      {shown_line(capability.message, limit=None)}\n", style="yellow")
-        one_sided = one_sided_sentence(capability, view.decimals, view.unit)
+        one_sided = one_sided_sentence(capability, view.resolution, view.unit)
         if one_sided:
             text.append(f"      {one_sided}\n")
         found = channel.out_of_spec
@@ -254,17 +252,19 @@ def spatial_text(view: SummaryView) -> Text:
     spatial = getattr(view.analysis, "spatial", None)
     if spatial is None:
         return Text("")
-    decimals = view.decimals
+    resolution = view.resolution
     text = Text("3-D\n", style="bold")
-    offsets = "  ".join(f"{axis} {number(v, decimals)}" for axis, v in spatial.offset.items())
+    offsets = "  ".join(
+        f"{axis} {format_figure(v, resolution)}" for axis, v in spatial.offset.items()
+    )
     text.append(f"  offset from nominal: {offsets} {view.unit}\n")
     text.append(
         f"  total offset √(Σ offset²) (ISO 9283 APp): "
-        f"{number(spatial.total_offset, decimals, signed=False)} {view.unit}\n"
+        f"{format_figure(spatial.total_offset, resolution, signed=False)} {view.unit}\n"
     )
     text.append(
         f"  ISO 9283 pose repeatability RP = l̄ + 3·S_l: "
-        f"{number(spatial.rp, decimals, signed=False)} {view.unit}\n"
+        f"{format_figure(spatial.rp, resolution, signed=False)} {view.unit}\n"
     )
     if spatial.message:
         text.append(f"  {spatial.message}\n", style="yellow")
