@@ -120,7 +120,7 @@ def _check_demo_choice(args: argparse.Namespace) -> None:
     here with a sentence (the TUI would open on it and wait forever)."""
     from station.errors import StationError
     from station.procedures import discover_procedures
-    from station.tui.screens.setup import DEMO_TRIAL_MINIMUM, count_field
+    from station.tui.screens.setup_form import DEMO_TRIAL_MINIMUM, count_field
 
     catalog = discover_procedures(args.procedures)
     if args.procedure not in catalog.ids():

@@ -692,7 +692,8 @@ async def test_linearity_one_sided_limits_are_explained_on_screen(
             ),
         )
         verdict = str(app.screen.query_one("#summary-verdict", Static).render())
-        assert "one-sided: upper limit 0.00200 in only" in verdict, verdict
+        # Signed like every limit on the screen (the histogram's "USL +0.00200").
+    assert "one-sided: upper limit +0.00200 in only" in verdict, verdict
 
 
 async def test_long_alarm_texts_open_in_full(tmp_path: Path, alarming_fixture, tui) -> None:

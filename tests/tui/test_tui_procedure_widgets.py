@@ -4,7 +4,7 @@ deviation plot, the buffer of the stroke under way, the set-up's count field."""
 from __future__ import annotations
 
 from station.procedures import discover_procedures
-from station.tui.screens.setup import count_field, judged_channels
+from station.tui.screens.setup_form import count_field, judged_channels
 from station.tui.screens.strokes import LiveStroke
 from station.tui.widgets.deviation_plot import DeviationData, Trace, render_deviation, trace
 

@@ -17,8 +17,15 @@ from rich.console import Console
 from station.analysis.capability import SpecLimits
 from station.analysis.summary import AnalysisConfig, analyze
 from station.errors import StationError
-from station.text import figure_decimals, format_figure, overall_verdict, verdict_word
-from station.tui.screens.setup import limits_text, parse_channel_map, parse_limits_text
+from station.text import (
+    figure_decimals,
+    format_figure,
+    limits_text,
+    overall_verdict,
+    parse_channel_map,
+    parse_limits_text,
+    verdict_word,
+)
 from station.tui.widgets.alarm_log import alarm_lines
 from station.tui.widgets.control_chart import chart_data, render_chart
 from station.tui.widgets.histogram import histogram_data, render_histogram

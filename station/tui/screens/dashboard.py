@@ -25,6 +25,7 @@ from station.errors import StationError
 from station.text import format_figure
 from station.tui.messages import CaptureFinished
 from station.tui.remedies import explained
+from station.tui.screens.dialogs import ConfirmScreen, FullTextScreen, HelpScreen, TextPrompt
 from station.tui.text import shown, shown_line
 from station.tui.widgets.alarm_log import AlarmLog, alarm_lines, recorded_alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
@@ -401,7 +402,6 @@ class DashboardScreen(Screen[None]):
         if reason is not None:
             self._in_thread(lambda: runner.reject_last(reason))
             return
-        from station.tui.screens.dialogs import TextPrompt
 
         def reject(text: str | None) -> None:
             if text:
@@ -421,7 +421,6 @@ class DashboardScreen(Screen[None]):
         runner = self.app.runner
         if not self.live or runner is None:
             return
-        from station.tui.screens.dialogs import TextPrompt
 
         def save(text: str | None) -> None:
             if text:
@@ -454,7 +453,6 @@ class DashboardScreen(Screen[None]):
             return
         counted = state.progress
         if counted is not None and not counted.enough and not force:
-            from station.tui.screens.dialogs import ConfirmScreen
 
             def finish(sure: bool | None) -> None:
                 if sure:
@@ -476,7 +474,7 @@ class DashboardScreen(Screen[None]):
 
     def action_alarms(self) -> None:
         """The alarm list: every alarm in full, acknowledged with a cause (live) or read."""
-        from station.tui.screens.alarms import AlarmsScreen
+        from station.tui.screens.alarms import AlarmsScreen  # deferred: loads when shown
 
         view = self.view
         alarms = tuple(view.alarms or ()) if view is not None else ()
@@ -496,13 +494,11 @@ class DashboardScreen(Screen[None]):
 
     def action_help(self) -> None:
         """The keys."""
-        from station.tui.screens.dialogs import HelpScreen
 
         self.app.push_screen(HelpScreen())
 
     def action_full_text(self) -> None:
         """``m``: the newest message and every alarm, in full (the lines here cut them)."""
-        from station.tui.screens.dialogs import FullTextScreen
 
         view = self.view
         lines: list[str] = []
@@ -526,7 +522,6 @@ class DashboardScreen(Screen[None]):
         if not self.live:
             self.app.pop_screen()
             return
-        from station.tui.screens.dialogs import ConfirmScreen
 
         def leave(sure: bool | None) -> None:
             if sure:
@@ -545,7 +540,7 @@ class DashboardScreen(Screen[None]):
 def out_of_spec_flags(last: Mapping[str, float], header: Mapping[str, Any]) -> dict[str, str]:
     """Channel -> "above" / "below" for each last reading beyond the session's specification
     limits (flagged the moment the reading is on disk, before the analysis catches up)."""
-    from station.session.header import header_limits
+    from station.session.header import header_limits  # deferred: it loads numpy
 
     flags: dict[str, str] = {}
     for channel, limits in header_limits(header).items():

@@ -27,9 +27,12 @@ from textual.message import Message
 from textual.screen import Screen
 from textual.widgets import Footer, Static
 
+from station.analysis.linearity import least_squares_line
 from station.errors import StationError
 from station.text import overall_verdict, verdict_word
 from station.tui.remedies import explained
+from station.tui.screens.dashboard import session_title
+from station.tui.screens.dialogs import ConfirmScreen, HelpScreen, TextPrompt
 from station.tui.text import shown
 from station.tui.theme import VERDICT_STYLES
 from station.tui.widgets.alarm_log import AlarmLog, alarm_lines
@@ -86,7 +89,6 @@ class LiveStroke:
 
 def _deviations(s: list[float], d: list[float]) -> list[float]:
     """Deviations from the least-squares line of the points so far (the analysis' line)."""
-    from station.analysis.linearity import least_squares_line
 
     if len(s) < 3 or max(s) - min(s) <= 0:
         return []
@@ -171,7 +173,6 @@ class StrokeDashboardScreen(Screen[None]):
         channels = self._channels()
         if self.selected not in channels:
             self.selected = channels[0]
-        from station.tui.screens.dashboard import session_title
 
         title = Text(session_title(header), style="bold")
         counted = state.progress
@@ -325,7 +326,6 @@ class StrokeDashboardScreen(Screen[None]):
             return
         counted = state.progress
         if counted is not None and not counted.enough and not force:
-            from station.tui.screens.dialogs import ConfirmScreen
 
             def finish(sure: bool | None) -> None:
                 if sure:
@@ -372,7 +372,6 @@ class StrokeDashboardScreen(Screen[None]):
         runner = self.app.runner
         if runner is None:
             return
-        from station.tui.screens.dialogs import TextPrompt
 
         def save(text: str | None) -> None:
             if text:
@@ -385,13 +384,11 @@ class StrokeDashboardScreen(Screen[None]):
 
     def action_help(self) -> None:
         """The keys."""
-        from station.tui.screens.dialogs import HelpScreen
 
         self.app.push_screen(HelpScreen())
 
     def action_leave(self) -> None:
         """Leave the session resumable (the stroke under way is cut short)."""
-        from station.tui.screens.dialogs import ConfirmScreen
 
         def leave(sure: bool | None) -> None:
             if sure:

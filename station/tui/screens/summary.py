@@ -10,6 +10,7 @@ session; the words and figures come from the analysis and the report module, unc
 
 from __future__ import annotations
 
+import io
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,16 +25,21 @@ from textual.containers import VerticalScroll
 from textual.screen import Screen
 from textual.widgets import Footer, Static
 
+from station.analysis.rules import rule_name
 from station.errors import StationError
+from station.session.durable import write_text_durably
+from station.session.export import export_csv
+from station.session.model import load_session
 from station.text import (
     format_figure,
     format_index,
     judged_cpk,
-    judged_label,
     judged_word,
     overall_judgement,
+    zero_taken,
 )
 from station.tui.remedies import explained
+from station.tui.screens.dialogs import HelpScreen
 from station.tui.text import shown, shown_line
 from station.tui.theme import VERDICT_STYLES
 
@@ -78,7 +84,6 @@ class SummaryView:
     @classmethod
     def from_file(cls, path: Path) -> SummaryView:
         """A saved session, read-only (the file is not changed, not even a torn tail)."""
-        from station.session.model import load_session
 
         session = load_session(path, recover=False)
         report, notes = _procedure_report(path, session.header, session)
@@ -119,7 +124,7 @@ def _procedure_report(
     """The session's report as its analysis kind makes it (through the registry: the verdict,
     and for kinds with a report block of their own, that block), and a note saying why there
     is none when the file has nothing to analyse yet. ``session``: the file already loaded."""
-    from station.text import zero_taken
+    # Deferred: the analysis kinds load numpy (on a worker while the screens before it show).
     from station.verdicts import load_session_source, report_session, session_source
 
     try:
@@ -180,7 +185,9 @@ def verdict_text(view: SummaryView) -> Text:
         capability = channel.capability
         descriptive = channel.descriptive
         text.append(f"  {shown_line(name, limit=20)}  ", style="bold")
-        text.append(f"{judged_label(channel):<11}", style=VERDICT_STYLES.get(word, ""))
+        # The word alone: the verdict line above says how many of how many (the axes share
+        # it), so the axis' figures fit one line at 80 columns ("σ" was left alone at its end).
+        text.append(f"{word:<11}", style=VERDICT_STYLES.get(word, ""))
         text.append(
             f" Cp {format_index(capability.cp)}  Cpk {judged_cpk(channel)} (95%: ≥"
             f"{format_index(capability.cpk_lower)})  X̄ "
@@ -208,7 +215,6 @@ def alarms_text(view: SummaryView) -> Text:
     """The alarms: those recorded while capturing (live, against the frozen limits) with their
     acknowledgements, and those of the retrospective chart (limits from every reading), each
     rule named in words and marked live or retrospective."""
-    from station.analysis.rules import rule_name
 
     text = Text("Alarms\n", style="bold")
     recorded = tuple(getattr(view.report, "recorded_alarms", None) or ())
@@ -375,7 +381,7 @@ class SummaryScreen(Screen[None]):
         """The filed report (the same as ``station report FILE``: robot, operator, procedure,
         gauges, zero, limits, every reading, notes, alarms, verdicts, anchor, sign-off) beside
         the session file, as text and as a self-contained HTML page with its charts."""
-        from station.record.render import render_report
+        from station.record.render import render_report  # deferred: it loads numpy
 
         try:
             text = render_report(self.view.path, "txt")
@@ -388,10 +394,6 @@ class SummaryScreen(Screen[None]):
 
     def action_export_csv(self) -> None:
         """Every cycle as tidy CSV (rejected ones marked) beside the session file."""
-        import io
-
-        from station.session.export import export_csv
-        from station.session.model import load_session
 
         try:
             session = load_session(self.view.path, recover=False)
@@ -404,7 +406,6 @@ class SummaryScreen(Screen[None]):
 
     def _write(self, target: Path, content: str, what: str) -> bool:
         """Write an export beside the session file; False (and a sentence) when refused."""
-        from station.session.durable import write_text_durably
 
         try:
             # Never through a link planted at the export's name, never over the session file.
@@ -426,6 +427,7 @@ class SummaryScreen(Screen[None]):
 
     def action_dashboard(self) -> None:
         """The statistics table and charts of this session, read-only."""
+        # Deferred: a screen loads when first shown.
         from station.tui.screens.dashboard import DashboardScreen, review_view, session_title
 
         header = self.view.header
@@ -460,7 +462,6 @@ class SummaryScreen(Screen[None]):
 
     def action_help(self) -> None:
         """The keys."""
-        from station.tui.screens.dialogs import HelpScreen
 
         self.app.push_screen(HelpScreen())
 

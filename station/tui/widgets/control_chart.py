@@ -84,10 +84,10 @@ def chart_data(
     labels = tuple(cycle_numbers[: len(points)]) if cycle_numbers else ()
     if len(labels) != len(points):
         labels = tuple(range(1, len(points) + 1))
-    title = (
-        f"{getattr(chart, 'type', 'control')} chart "
-        f"{shown_line(getattr(channel, 'name', ''), limit=20)}"
-    ).strip()
+    kind = getattr(chart, "type", "control")
+    name = shown_line(getattr(channel, "name", ""), limit=20)
+    # Short, so "(last 26 of 60)" and the alarm mark's legend still fit beside it.
+    title = f"{kind} {name}, frozen limits" if frozen is not None else f"{kind} chart {name}"
     return ChartData(
         points=points,
         center=_finite(getattr(lines, "center", None)),
@@ -96,7 +96,7 @@ def chart_data(
         alarm_points=frozenset(alarmed),
         labels=labels,
         resolution=resolution,
-        title=f"{title}, frozen limits" if frozen is not None else title,
+        title=title.strip(),
         message=str(getattr(chart, "message", "") or ""),
         label=label,
     )
