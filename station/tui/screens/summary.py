@@ -389,8 +389,11 @@ class SummaryScreen(Screen[None]):
         except StationError as error:
             self.notify(shown_line(explained(error), limit=None), severity="error", markup=False)
             return
-        if self._write(self._export_path(".report.txt"), text, "report"):
-            self._write(self._export_path(".report.html"), page, "HTML report")
+        txt, html = self._export_path(".report.txt"), self._export_path(".report.html")
+        if self._write(txt, text, "report") and self._write(html, page, "HTML report"):
+            # One line, whole: the files are named after the session file (its block above
+            # lists their full paths); a path cut at the screen's edge said nothing.
+            self.notify("Report filed beside the session file, as .report.txt and .report.html")
 
     def action_export_csv(self) -> None:
         """Every cycle as tidy CSV (rejected ones marked) beside the session file."""
@@ -402,7 +405,9 @@ class SummaryScreen(Screen[None]):
             return
         buffer = io.StringIO()
         export_csv(session, buffer)
-        self._write(self._export_path(".csv"), buffer.getvalue(), "CSV")
+        target = self._export_path(".csv")
+        if self._write(target, buffer.getvalue(), "CSV"):
+            self.notify("CSV filed beside the session file, as .csv")
 
     def _write(self, target: Path, content: str, what: str) -> bool:
         """Write an export beside the session file; False (and a sentence) when refused."""
@@ -422,7 +427,6 @@ class SummaryScreen(Screen[None]):
             return False
         self.exported.append(f"{what} exported to {target}")
         self._refresh_file()
-        self.notify(shown_line(f"{what} exported to {target}", limit=None), markup=False)
         return True
 
     def action_dashboard(self) -> None:
