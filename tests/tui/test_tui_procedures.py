@@ -146,6 +146,11 @@ async def test_relative_accuracy_through_the_tui(tmp_path: Path, lab: DemoLab, t
             )
         await tui.wait_until(pilot, lambda: isinstance(app.screen, DashboardScreen))
         await pilot.pause()
+        app.redraw_live()
+        await pilot.pause()
+        # Finding 9: the prompt said "Every cycle asked for is captured" of placements.
+        prompt = text_of(app, "#dash-prompt")
+        assert "Every placement asked for is captured" in prompt, prompt
         await pilot.press("f")
         await tui.wait_until(pilot, lambda: isinstance(app.screen, SummaryScreen))
         await tui.wait_until(pilot, lambda: bool(app.screen.query("#summary-report")))

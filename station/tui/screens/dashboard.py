@@ -102,7 +102,10 @@ class DashboardView:
         if state.placement is not None and state.placements:
             progress = f"placement {state.placement} of {state.placements}, {progress}"
         if ready:
-            noun = counted.noun if counted is not None else "cycle"
+            # After the last step of a repeated block (relative accuracy) nothing counts any
+            # more: what was asked for were placements, not cycles.
+            placed = last_cycle is not None and last_cycle.placement is not None
+            noun = counted.noun if counted is not None else "placement" if placed else "cycle"
             prompt = f"Every {noun} asked for is captured. Press f to finish and see the verdict."
         if rejected:
             progress += f", {rejected} rejected"
