@@ -184,13 +184,14 @@ def verdict_text(view: SummaryView) -> Text:
         word = judged_word(channel)
         capability = channel.capability
         descriptive = channel.descriptive
+        bound = capability.cpk_lower
+        lower = f"≥{format_index(bound)}" if bound is not None else format_index(None)
         text.append(f"  {shown_line(name, limit=20)}  ", style="bold")
         # The word alone: the verdict line above says how many of how many (the axes share
         # it), so the axis' figures fit one line at 80 columns ("σ" was left alone at its end).
         text.append(f"{word:<11}", style=VERDICT_STYLES.get(word, ""))
         text.append(
-            f" Cp {format_index(capability.cp)}  Cpk {judged_cpk(channel)} (95%: ≥"
-            f"{format_index(capability.cpk_lower)})  X̄ "
+            f" Cp {format_index(capability.cp)}  Cpk {judged_cpk(channel)} (95%: {lower})  X̄ "
             f"{format_figure(descriptive.mean, view.resolution)}"
             f"  σ {format_figure(descriptive.sd, view.resolution, signed=False)}\n"
         )
