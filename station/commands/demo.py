@@ -95,7 +95,8 @@ def run(args: argparse.Namespace) -> int:
         fixture = lab.fixture(args.procedure)
         config = StationConfig(
             sessions_dir=folder / "demo",
-            sessions_reason=f"the demo folder under {folder} ({reason})",
+            # The path above already names the folder: say only why it is this one.
+            sessions_reason=f"the demo's own folder in the sessions folder, {reason}",
             procedure_dirs=tuple(Path(p) for p in args.procedures),
             demo=DemoPort(
                 url=fixture.url,
