@@ -29,7 +29,7 @@ from textual.widgets import Footer, Static
 
 from station.analysis.linearity import least_squares_line
 from station.errors import StationError
-from station.text import overall_verdict, verdict_word
+from station.text import overall_judgement
 from station.tui.remedies import explained
 from station.tui.screens.dashboard import session_title
 from station.tui.screens.dialogs import ConfirmScreen, HelpScreen, TextPrompt
@@ -228,10 +228,11 @@ class StrokeDashboardScreen(Screen[None]):
             )
         text = Text()
         if self.result is not None:
-            words = [verdict_word(a.capability) for a in self.result.judged.values()]
-            overall = overall_verdict(words)
+            # The table's own judgement (PROVISIONAL below the minimum count), not a bare
+            # CAPABLE beside rows that say PROVISIONAL.
+            overall = overall_judgement(self.result.judged.values())
             text.append("Verdict so far: ", style="bold")
-            text.append(overall, style=VERDICT_STYLES.get(overall, ""))
+            text.append(overall, style=VERDICT_STYLES.get(overall.partition(":")[0], ""))
             text.append(" (straightness per stroke, minimum zone).  ")
         if self.streaming:
             text.append("Let the robot shuttle A↔B; e ends the stroke now, f finishes.")
