@@ -103,12 +103,16 @@ def test_autopilot_demo_reaches_the_verdict(tmp_path: Path) -> None:
         lines = [line.strip() for line in screen.splitlines()]
         axis_lines = [line for line in lines if line[:2] in ("x ", "y ", "z ")]
         assert len(axis_lines) == 3, screen
-        # Five cycles are a trial run: each axis says PROVISIONAL with its count (a word, never
-        # only a colour), or a final word.
+        # Five cycles are a trial run: each axis says PROVISIONAL (a word, never only a
+        # colour), or a final word, with its figures whole on its line at 80 columns; the
+        # verdict line says the count.
         for line in axis_lines:
-            assert any(word in line for word in ("CAPABLE", "UNDEFINED", "PROVISIONAL: 5 of")), line
+            assert any(word in line for word in ("CAPABLE", "UNDEFINED", "PROVISIONAL")), line
+            assert re.search(r"σ \d\.\d{5}$", line), line
         verdict = next(line for line in lines if line.startswith("Verdict:"))
         assert verdict.split()[1] in ("CAPABLE", "NOT", "UNDEFINED", "PROVISIONAL:"), verdict
+        if "PROVISIONAL" in screen:
+            assert verdict.startswith("Verdict: PROVISIONAL: 5 of "), verdict
         sessions = list((tmp_path / "demo").glob("*.jsonl"))
         assert len(sessions) == 1
         verify = subprocess.run(
@@ -177,9 +181,11 @@ def test_autopilot_demo_of_each_procedure_reaches_its_verdict(
         lines = [line.strip() for line in screen.splitlines()]
         verdict_lines = [line for line in lines if line[:2] in channels]
         assert len(verdict_lines) == len(channels), screen
-        # The demo's short count is below the procedure's minimum: provisional, with the count.
+        # The demo's short count is below the procedure's minimum: provisional (the count on
+        # the verdict line), each axis' figures whole on its line at 80 columns.
         for line in verdict_lines:
-            assert f"PROVISIONAL: {count} of " in line or "UNDEFINED" in line, line
+            assert "PROVISIONAL" in line or "UNDEFINED" in line, line
+            assert re.search(r"σ \d\.\d{5}$", line), line
         verdict = next(line for line in lines if line.startswith("Verdict:"))
         assert verdict.startswith(f"Verdict: PROVISIONAL: {count} of "), verdict
         sessions = list((tmp_path / "demo").glob("*.jsonl"))
