@@ -277,6 +277,10 @@ async def test_a_linearity_session_left_and_resumed_goes_on_from_its_strokes(
         # The strokes recorded before the break are drawn again, and streaming goes on to 4.
         await tui.wait_until(pilot, lambda: dashboard.result is not None, timeout=30)
         assert len(dashboard.result.strokes) >= 2
+        # The verdict so far is the table's (PROVISIONAL below 25 strokes), never a bare
+        # CAPABLE beside rows that say PROVISIONAL.
+        prompt = text_of(app, "#dash-prompt")
+        assert "Verdict so far: PROVISIONAL: " in prompt, prompt
         await tui.wait_until(
             pilot,
             lambda: app.runner.state().progress.done >= 4 and not dashboard.streaming,
