@@ -50,6 +50,7 @@ from station.analysis.summary import (
     channel_to_json,
 )
 from station.errors import StationError
+from station.text import format_figure
 
 #: The indicator channels of the linearity set-up, and the scale.
 INDICATORS = ("h", "v")
@@ -483,6 +484,11 @@ def linearity_hints(result: LinearityAnalysis) -> tuple[str, ...]:
     """What stands out in a linearity analysis, in the report's manner of hints."""
     hints: list[str] = []
     unit = f" {result.unit}" if result.unit else ""
+    resolution = result.config.resolution
+
+    def figure(value: float) -> str:
+        return format_figure(value, resolution, signed=False)
+
     for c in result.channels:
         values = [r.straightness[c].mz for r in result.strokes]
         if result.tolerance is not None:
@@ -490,7 +496,8 @@ def linearity_hints(result: LinearityAnalysis) -> tuple[str, ...]:
             if over:
                 hints.append(
                     f"{c}: {over} of {len(values)} strokes exceed the straightness tolerance "
-                    f"{result.tolerance:g}{unit} (largest {max(values):.4g}{unit}): the path "
+                    f"{figure(result.tolerance)}{unit} (largest {figure(max(values))}{unit}): the "
+                    "path "
                     "bends more than allowed; compare with the bar's own straightness."
                 )
         if len(result.directions) == 2:
@@ -499,7 +506,8 @@ def linearity_hints(result: LinearityAnalysis) -> tuple[str, ...]:
             if low > 0 and high > 1.5 * low:
                 hints.append(
                     f"{c}: the straightness differs by direction (mean MZ A→B "
-                    f"{forward.mz_mean[c]:.6g}, B→A {backward.mz_mean[c]:.6g}{unit}): look at "
+                    f"{figure(forward.mz_mean[c])}, B→A {figure(backward.mz_mean[c])}{unit}): "
+                    "look at "
                     "backlash or the controller's tracking in one direction."
                 )
         alarms = result.judged[c].alarms

@@ -144,13 +144,15 @@ def test_demo_autopilot_count_5_ends_on_the_verdict(
         lines = [line.strip() for line in screen.splitlines()]
         verdict_lines = [line for line in lines if line[:2] in channels]
         assert len(verdict_lines) == len(channels), screen
-        # A word, never only a colour; below the procedure's minimum a trial run is provisional
-        # with its count.
+        # A word, never only a colour, with each axis' figures whole on its line at 80
+        # columns; below the procedure's minimum a trial run is provisional (the count on the
+        # verdict line).
         for line in verdict_lines:
             if minimum > 5:
-                assert "PROVISIONAL: 5 of " in line or "UNDEFINED" in line, line
+                assert "PROVISIONAL" in line or "UNDEFINED" in line, line
             else:
                 assert any(word in line for word in ("CAPABLE", "UNDEFINED")), line
+            assert re.search(r"σ \d\.\d{5}$", line), line
         verdict = next(line for line in lines if line.startswith("Verdict:"))
         assert verdict.split()[1] in ("CAPABLE", "NOT", "UNDEFINED", "PROVISIONAL:"), verdict
         if minimum > 5:
