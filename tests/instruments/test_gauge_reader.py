@@ -8,8 +8,9 @@ import time
 import pytest
 
 from station.errors import StationError
-from station.instruments.gauge import GaugeReader, GaugeSet, PortSpec
+from station.instruments.gauge import GaugeSet, PortSpec
 from station.instruments.protocols import get_protocol, protocol_names
+from station.instruments.reader import GaugeReader
 from station.instruments.simulator import (
     AxisModel,
     Faults,

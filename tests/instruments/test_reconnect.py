@@ -11,8 +11,9 @@ import time
 
 import pytest
 
-from station.instruments.gauge import DEFAULT_BACKOFF, GaugeReader, GaugeSet, PortSpec
+from station.instruments.gauge import GaugeSet, PortSpec
 from station.instruments.protocols import get_protocol
+from station.instruments.reader import DEFAULT_BACKOFF, GaugeReader
 from station.instruments.simulator import GaugeSpec, RampModel, Simulator
 
 FAST = (0.05, 0.2)
