@@ -82,6 +82,7 @@ from typing import Any, Literal
 
 from station.errors import StationError
 from station.instruments.arrival import ArrivalConfig
+from station.instruments.triggers import TRIGGERS
 from station.instruments.zeroing import (
     DEFAULT_ZERO_SETTLE,
     DEFAULT_ZERO_STILL,
@@ -603,11 +604,8 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
     limits = _parse_limits(check, check.get(table, "limits", dict, "", required=False), channels)
     arrival = _parse_arrival(check, check.get(table, "arrival", dict, "", required=False))
     trigger = check.get(table, "trigger", str, "", required=False)
-    if trigger is not None:
-        from station.instruments.gauge import TRIGGERS
-
-        if trigger not in TRIGGERS:
-            raise check.fail("", f"'trigger' must be one of {', '.join(TRIGGERS)}, not {trigger!r}")
+    if trigger is not None and trigger not in TRIGGERS:
+        raise check.fail("", f"'trigger' must be one of {', '.join(TRIGGERS)}, not {trigger!r}")
 
     raw_steps = check.get(table, "steps", list, "")
     if not raw_steps:

@@ -1,17 +1,7 @@
 """Reading sets by trigger: what a capture returns, and how each trigger takes one.
 
 A :class:`~station.instruments.gauge.GaugeSet` turns its readers' streams into reading sets by
-trigger:
-
-* ``poll``: each capture sends the requests; only answers read after the request count.
-* ``push``: the device sends (DATA button, foot switch, data logger); a set completes when every
-  channel has a reading since the last set.
-* ``stable``: stream (polling continuously when the device is polled) and take the set once every
-  channel has stayed within ``k`` × resolution for ``T`` ms.
-* ``arrival``: read continuously (a background thread polls a polled device); the robot's own
-  motion paces the cycles: a set is taken when the indicators have left their working band and
-  come back to rest (:mod:`station.instruments.arrival`). Sets go to ``on_set`` as push sets do;
-  a return that does not settle goes to ``on_arrival`` with a sentence, and is not a set.
+trigger (:mod:`station.instruments.triggers` says what each means); this module takes them.
 
 A port that is down when a capture starts is waited for until the capture's timeout (a short
 dropout costs a delay, not a refused set); a channel still missing because its port stayed down

@@ -18,7 +18,6 @@ import time
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Literal
 
 from station.errors import StationError
 from station.instruments.arrival import ArrivalConfig, ArrivalDetector, ArrivalEvent
@@ -34,10 +33,8 @@ from station.instruments.reader import (
     TriggerTicket,
     call_quietly,
 )
+from station.instruments.triggers import TRIGGERS, Trigger
 from station.instruments.zero_gauges import SetZeroing
-
-Trigger = Literal["poll", "push", "stable", "arrival"]
-TRIGGERS: tuple[str, ...] = ("poll", "push", "stable", "arrival")
 
 
 @dataclass(frozen=True)
