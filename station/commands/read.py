@@ -144,8 +144,9 @@ def _print_item(item: object, jsonl: bool, resolution: float) -> bool:
 def run(args: argparse.Namespace) -> int:
     """Read until --count readings arrived or Ctrl-C."""
     from station.instruments.arrival import DEFAULT_TIMEOUT, ArrivalConfig
-    from station.instruments.gauge import GaugeReader, GaugeSet, PortSpec
+    from station.instruments.gauge import GaugeSet, PortSpec
     from station.instruments.protocols import get_protocol
+    from station.instruments.reader import GaugeReader
 
     count = positive_number(args.count, "--count", int)
     interval = positive_number(args.interval, "--interval")

@@ -12,15 +12,15 @@ from __future__ import annotations
 import errno
 import os
 import re
+import termios
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+
+import serial
+from serial.tools import list_ports as serial_list_ports
 
 from station.errors import StationError
 from station.instruments.base import SerialSettings
-
-if TYPE_CHECKING:
-    import serial
 
 NETWORK_SCHEMES = ("socket", "rfc2217")
 """URL schemes that reach a device over TCP: no local lock applies to them."""
@@ -65,8 +65,6 @@ def list_ports() -> list[PortInfo]:
     Pseudo-terminals (``/dev/pts/*``) and network URLs are never listed (pyserial issue #457), but
     :func:`open_port` opens them all the same.
     """
-    from serial.tools import list_ports as serial_list_ports
-
     links = _by_id_links()
     ports = []
     for port in serial_list_ports.comports():
@@ -212,10 +210,6 @@ def open_port(
     ``exclusive`` takes a POSIX ``flock`` on local devices so a second program cannot steal frames;
     network URLs have no local lock, so it is not passed to them.
     """
-    import termios
-
-    import serial
-
     if not isinstance(url, str) or not url.strip():
         raise StationError(
             "No port given: name the gauge's port, e.g. /dev/ttyUSB0 or rfc2217://HOST:PORT",

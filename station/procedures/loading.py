@@ -16,6 +16,7 @@ from typing import Any
 from station.errors import StationError
 from station.inputfiles import read_input_bytes
 from station.instruments.arrival import ArrivalConfig
+from station.instruments.triggers import TRIGGERS
 from station.instruments.zeroing import DEFAULT_ZERO_SETTLE, DEFAULT_ZERO_STILL
 from station.procedures.checker import TOML_DEPTH_LIMIT, Checker, toml_nesting_depth
 from station.procedures.kinds import (
@@ -120,13 +121,8 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
     limits = _parse_limits(check, check.get(table, "limits", dict, "", required=False), channels)
     arrival = _parse_arrival(check, check.get(table, "arrival", dict, "", required=False))
     trigger = check.get(table, "trigger", str, "", required=False)
-    if trigger is not None:
-        # Deferred: the gauge module loads pyserial, which `station --help` (every command's
-        # parser loads this package) need not pay for; only a file naming a trigger needs it.
-        from station.instruments.gauge import TRIGGERS
-
-        if trigger not in TRIGGERS:
-            raise check.fail("", f"'trigger' must be one of {', '.join(TRIGGERS)}, not {trigger!r}")
+    if trigger is not None and trigger not in TRIGGERS:
+        raise check.fail("", f"'trigger' must be one of {', '.join(TRIGGERS)}, not {trigger!r}")
 
     raw_steps = check.get(table, "steps", list, "")
     if not raw_steps:

@@ -84,7 +84,8 @@ from station.session.journal import SessionWriter
 from station.session.model import Session
 
 if TYPE_CHECKING:
-    from station.instruments.gauge import CaptureResult, Subscription
+    from station.instruments.capture import CaptureResult
+    from station.instruments.gauge import Subscription
 
 CAPTURE_BY = "station capture"
 """The ``by`` recorded when the headless command confirms a step itself."""

@@ -24,7 +24,8 @@ from station.run.state import (
 from station.run.steps import handler_for
 
 if TYPE_CHECKING:
-    from station.instruments.gauge import CaptureResult, PortStatus
+    from station.instruments.capture import CaptureResult
+    from station.instruments.reader import PortStatus
 
 
 class InstrumentIntake:

@@ -7,11 +7,11 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from station.instruments.gauge import unit_mismatch
+from station.instruments.units import unit_mismatch
 from station.session.model import event_seconds
 
 if TYPE_CHECKING:
-    from station.instruments.gauge import CaptureResult
+    from station.instruments.capture import CaptureResult
 
 DEVICE_DRIVEN_TRIGGERS = ("push", "arrival")
 """Triggers where the devices (a DATA press, the robot's arrival) decide when a set is taken:

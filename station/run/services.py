@@ -25,7 +25,7 @@ from station.run.steps import handler_for
 from station.run.steps.base import PlanItem, StepHandler
 
 if TYPE_CHECKING:
-    from station.instruments.gauge import CaptureResult
+    from station.instruments.capture import CaptureResult
 
 
 class StepServices:

@@ -14,8 +14,10 @@ from typing import Any
 from station.analysis.capability import SpecLimits
 from station.errors import StationError
 from station.instruments.base import SerialSettings
-from station.instruments.gauge import DEFAULT_BACKOFF, TRIGGERS, GaugeSet, PortSpec, Trigger
+from station.instruments.gauge import GaugeSet, PortSpec
 from station.instruments.protocols import get_protocol
+from station.instruments.reader import DEFAULT_BACKOFF
+from station.instruments.triggers import TRIGGERS, Trigger
 from station.procedures import Procedure, Step, discover_procedures
 from station.run.steps import handler_for
 from station.run.steps.base import PlanItem

@@ -23,8 +23,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from station.instruments.framing import FrameSplitter  # noqa: E402
-from station.instruments.gauge import GaugeReader  # noqa: E402
 from station.instruments.protocols import get_protocol  # noqa: E402
+from station.instruments.reader import GaugeReader  # noqa: E402
 from station.instruments.simulator import GaugeSpec, RampModel, Simulator  # noqa: E402
 
 

@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import queue
+import threading
 import time
 
 import pytest
+from waiting import wait_until
 
 from station.errors import StationError
-from station.instruments.gauge import GaugeReader, GaugeSet, PortSpec
+from station.instruments.gauge import GaugeSet, PortSpec
 from station.instruments.protocols import get_protocol, protocol_names
+from station.instruments.reader import GaugeReader
 from station.instruments.simulator import (
     AxisModel,
     Faults,
@@ -132,8 +135,11 @@ def test_stale_frames_from_before_the_trigger_are_never_taken() -> None:
         gauges.start()
         assert gauges.wait_connected(3.0)
         first = gauges.capture(2.0)
+        reader = gauges.readers[0]
+        read_before = reader.reading_count
         sim.stale_burst(3)  # old frames delivered late, between two captures
-        time.sleep(0.1)
+        # They must be in before the second trigger (else they would be new frames to it).
+        assert wait_until(lambda: reader.reading_count >= read_before + 3)
         second = gauges.capture(2.0)
     finally:
         gauges.stop()
@@ -229,7 +235,6 @@ def test_zero_uses_the_device_command_or_a_software_offset() -> None:
         assert gauges.wait_connected(3.0)
         zeros = gauges.zero()
         after = gauges.capture(2.0)
-        time.sleep(0.05)
     finally:
         gauges.stop()
         cdi.stop()
@@ -257,15 +262,24 @@ def test_rejections_are_counted_kept_and_queued_and_readings_survive_them() -> N
     sim = make_sim("mitutoyo", faults=faults)
     url = sim.start_pty()
     events: queue.Queue = queue.Queue()
+    device_error = threading.Event()
+
+    def note(rejection) -> None:
+        if rejection.reason == "error":
+            device_error.set()
+
     gauges = GaugeSet(
-        [PortSpec(url, get_protocol("mitutoyo"), station_map(sim))], events=events, backoff=FAST
+        [PortSpec(url, get_protocol("mitutoyo"), station_map(sim))],
+        events=events,
+        on_rejection=note,
+        backoff=FAST,
     )
     try:
         gauges.start()
         assert gauges.wait_connected(3.0)
         results = [gauges.capture(2.0) for _ in range(10)]
         sim.inject("error", "2")
-        time.sleep(0.1)
+        assert device_error.wait(5.0), "the device's error frame never came through"
     finally:
         gauges.stop()
         sim.stop()
@@ -324,7 +338,7 @@ def test_stop_returns_promptly_even_while_reading() -> None:
     reader = GaugeReader(url, get_protocol("uwave"), {"1": "x"}, backoff=FAST)
     reader.start()
     assert reader.wait_connected(3.0)
-    time.sleep(0.1)
+    assert wait_until(lambda: reader.reading_count >= 10)  # in the middle of a stream
     began = time.monotonic()
     reader.stop()
     took = time.monotonic() - began

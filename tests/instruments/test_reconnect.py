@@ -10,9 +10,11 @@ import threading
 import time
 
 import pytest
+from waiting import wait_until
 
-from station.instruments.gauge import DEFAULT_BACKOFF, GaugeReader, GaugeSet, PortSpec
+from station.instruments.gauge import GaugeSet, PortSpec
 from station.instruments.protocols import get_protocol
+from station.instruments.reader import DEFAULT_BACKOFF, GaugeReader
 from station.instruments.simulator import GaugeSpec, RampModel, Simulator
 
 FAST = (0.05, 0.2)
@@ -87,8 +89,10 @@ def test_unplug_mid_stream_then_return(transport: str) -> None:
         returned_at = record.connected_at[1]
         assert record.wait_for(lambda r: len(r.readings) >= count_at_return + 60)
         time.sleep(0.05)
-        sim.push_rate = 0  # stop the stream, then let the last frames land
+        sim.push_rate = 0  # stop the stream (the simulator's loop sees it within 0.05 s)
         time.sleep(0.2)
+        # Then let the last frames land, however slowly a loaded machine delivers them.
+        assert record.wait_for(lambda r: r.readings[-1].value == sim.sent["x"][-1].value)
     finally:
         reader.stop()
         sim.stop()
@@ -148,21 +152,29 @@ def test_back_off_doubles_to_its_cap_and_stop_cuts_it_short() -> None:
 
     missing = "/dev/ttyUSB_station_gone"
     reader = GaugeReader(missing, get_protocol("mitutoyo"), backoff=(0.05, 0.2), on_status=note)
+    began = time.monotonic()
     reader.start()
-    time.sleep(1.0)
+    # Five failed attempts: four waits (0.05, 0.1, then twice the 0.2 cap).
+    assert wait_until(lambda: len(attempts) >= 5, timeout=10.0)
     reader.stop()
+    took = time.monotonic() - began
     gaps = [later - earlier for earlier, later in zip(attempts, attempts[1:], strict=False)]
     assert len(gaps) >= 4
     # Each wait is at least the back-off of its turn: 0.05, 0.1, 0.2, then capped at 0.2.
     for gap, least in zip(gaps, [0.05, 0.1, 0.2, 0.2, 0.2], strict=False):
         assert gap >= least * 0.95
-    assert len(attempts) <= 1 + 1.0 / 0.05  # never faster than the first back-off
+    assert len(attempts) <= 1 + took / 0.05  # never faster than the first back-off
     assert "There is no serial port" in reader.last_message or reader.state == "stopped"
 
     # With the real back-off the thread sleeps up to 5 s between attempts; stop() still returns.
-    slow = GaugeReader(missing, get_protocol("mitutoyo"))
+    failed = threading.Event()
+    slow = GaugeReader(
+        missing,
+        get_protocol("mitutoyo"),
+        on_status=lambda status: status.state == "disconnected" and failed.set(),
+    )
     slow.start()
-    time.sleep(0.1)
+    assert failed.wait(10.0)  # the first attempt failed: the thread waits out its back-off
     began = time.monotonic()
     slow.stop()
     assert time.monotonic() - began < 1.0

@@ -9,6 +9,7 @@ import statistics
 import time
 
 import pytest
+from waiting import wait_until
 
 from station.errors import StationError
 from station.instruments.base import Rejected, Value
@@ -26,8 +27,11 @@ from station.instruments.simulator import (
 )
 
 
-def read_frames(fd_or_sock, protocol, count: int, timeout: float = 2.0) -> list[bytes]:
-    """Read ``count`` frames from a raw pty slave fd or a socket, with the protocol's splitter."""
+def read_frames(fd_or_sock, protocol, count: int, timeout: float = 10.0) -> list[bytes]:
+    """Read ``count`` frames from a raw pty slave fd or a socket, with the protocol's splitter.
+
+    Returns as soon as ``count`` frames are in: the timeout only bounds a wait for frames that
+    never come (generous, for a loaded machine)."""
     splitter = FrameSplitter(protocol.terminator)
     frames: list[bytes] = []
     deadline = time.monotonic() + timeout
@@ -130,7 +134,7 @@ def test_tcp_answers_polls_and_zero_commands_and_comes_back_on_the_same_port() -
             client.sendall(b"R\r")
             assert len(read_frames(client, protocol, 1)) == 1
             client.sendall(b"C\r")
-            time.sleep(0.1)
+            assert wait_until(lambda: sim.zero_requests)
             assert sim.zero_requests == ["x"]
             sim.disconnect(down_time=0.2)
             assert client.recv(100) == b""  # the server went away
