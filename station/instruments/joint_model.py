@@ -35,7 +35,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from station.errors import StationError
-from station.instruments.simulator import GaugeSpec, RobotModel, _skew_normal_unit
+from station.instruments.simulator import GaugeSpec, RobotModel, skew_normal_unit
 
 JOINTS = 3
 #: The fixture's indicators: 0.0001 in over ±0.5 in.
@@ -143,7 +143,7 @@ class JointModel(RobotModel):
         direction = 1.0 if cycle % 2 == 0 else -1.0
         return (
             fault.offset
-            + fault.noise * _skew_normal_unit(fault.skew, z0, z1)
+            + fault.noise * skew_normal_unit(fault.skew, z0, z1)
             + direction * fault.backlash / 2.0
             + overshoot
         )
