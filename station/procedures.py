@@ -55,7 +55,7 @@ Keys per step kind, beyond ``id``, ``kind``, ``title`` and ``text``:
 
 - ``input``: ``fields = [{ name, label, type = "number"|"text", unit, required }]``
 - ``zero``: ``channels`` (default: all), ``readings`` (per channel, 2 or more: the zero is
-  their mean; without it the gauge's zero command, else one reading set), ``settle`` (seconds
+  their mean; default 5, or 3 DATA presses with the push trigger), ``settle`` (seconds
   the readings are spread over; default 1.0) and ``still`` (resolutions the readings may spread
   before a gauge counts as moving and the zero is refused; default 3)
 - ``capture``: ``channels`` (default: all the procedure's channels)
@@ -270,8 +270,8 @@ class Step:
     options: Mapping[str, Any] = field(default_factory=dict)
     """The values of the keys a registered step kind declares as its own (``schema.keys``)."""
     readings: int | None = None
-    """A ``zero`` step: readings per channel the zero is the mean of (None: the gauge's zero
-    command, else one reading set; always None for other kinds)."""
+    """A ``zero`` step: readings per channel the zero is the mean of (None: the engine's default
+    for the session's trigger, always several; always None for other kinds)."""
     settle: float | None = None
     """A ``zero`` step: seconds its readings are spread over."""
     still: float | None = None
@@ -840,9 +840,8 @@ def _parse_step(context: _StepContext, raw: Any, number: str, *, nested: bool = 
             raise check.fail(
                 where, f"'readings' must be 2 or more (a zero is a mean), not {readings}"
             )
-        # Without ``readings`` the step zeroes as before this window existed: the gauge's own
-        # zero command, else one reading set (a simulated set-up that counts its readings at
-        # home relies on it); ``settle`` and ``still`` then keep their defaults for the record.
+        # Without ``readings`` the engine chooses by the session's trigger (several readings
+        # always: one reading is no zero); ``settle`` and ``still`` keep their defaults.
         values["readings"] = readings
         for key, default in (("settle", DEFAULT_ZERO_SETTLE), ("still", DEFAULT_ZERO_STILL)):
             number = check.number(raw, key, where, required=False)

@@ -32,10 +32,8 @@ others):
                (printed on stderr as "placement P: the pendant reads X=...
                Y=... Z=... in" when the robot gets there); the indicators at
                the first fixture read the return's error: --scale per unit
-               moved, --rotation (radians) about x, y, z, --noise. A protocol
-               without a zero command is zeroed in software, which reads one
-               set at home per placement; the simulated robot follows that
-               order (one home reading, then the return).
+               moved, --rotation (radians) about x, y, z, --noise. Each
+               placement is a rest at home (the zero), then the return.
   bar          linearity (report 2.9): indicators h, v and the linear scale s
                in inches. The robot shuttles A-B-A... along the bar (--length,
                --points per stroke, --dwell readings at each end); h sees the
@@ -43,8 +41,9 @@ others):
                wobble (--wobble, --wobble-v, --period). The indicators and the
                scale's counter send every set by themselves at --push-rate sets
                per second (default 200, as a counter's continuous output does):
-               capture with --trigger push. The robot advances one point per
-               set sent.
+               capture with --trigger push. The robot stands still at A for
+               --hold seconds (default 8) from the first frame it sends, where the
+               station zeroes, then advances one point per set sent.
   joints       per-joint troubleshooting (report 1.2, 2.8): x, y, z in inches
                at the fixture of a 3-joint arm (base, shoulder, elbow), each
                joint moved alone for --cycles-per-joint returns in turn (joint
@@ -53,25 +52,35 @@ others):
                J with --joint-fault backlash|noise|servo|encoder of
                --fault-size radians; the healthy joints repeat to 5e-6 rad.
                Printed on stderr as "joint J: ..." when the next joint's turn
-               comes, with its lever arm. A protocol without a zero command is
-               zeroed in software, which reads one set at the taught position
-               before each joint's returns; the simulated arm follows that.
+               comes, with its lever arm. Each joint's turn is a rest at the
+               taught position (the zero), then its returns.
   gauge-bench  the gauge check (Type-1 study): one indicator x in inches over
                a surface plate (zeroing reads the plate), a gauge block of
                --reference size re-seated for every reading, read with the
-               indicator's --bias and --noise (default 0.00003). A software
-               zero (no zero command) reads the plate once first.
+               indicator's --bias and --noise (default 0.00003). The first
+               rest is the plate (the zero), every later one a seating.
 
---cycle-period S makes the fixture model's robot leave the fixture and come
-back every S seconds, as a playback loop does: at rest (the model's bias,
-noise, drift and backlash for that cycle), then the indicators run out to
-their free travel (--free-travel, default -3/8 in or -9.525 mm) while the
-robot is away, then it returns with a short overshoot (--overshoot, default
-20 resolutions) and settles. The c-th rest position is the model's c-th value;
-a reading shows where the robot is when it is sent. --hunt CH=V makes an axis
-hunt by +-V at rest on every --hunt-every N-th return instead of settling
-(a return the station must report, not record).
+The models follow the robot's state, not the readings: at each rest every
+reading shows the same rest position plus the indicators' own noise
+(--gauge-noise, in resolutions), however often the station reads it. Without
+--cycle-period the robot stays at its first rest. --cycle-period S makes the
+robot leave the fixture and come back every S seconds, as a playback loop
+does: at rest (the model's bias, noise, drift and backlash for that cycle),
+then the indicators run out to their free travel (--free-travel, default
+-3/8 in or -9.525 mm) while the robot is away, then it returns with a short
+overshoot (--overshoot, default 20 resolutions) and settles. The c-th rest
+position is the model's c-th value; a reading shows where the robot is when
+it is sent. --hunt CH=V makes an axis hunt by +-V at rest on every --hunt-
+every N-th return instead of settling (a return the station must report, not
+record). With two-fixture, joints and gauge-bench the rests where the
+procedure zeroes (home, the taught position before each joint, the plate)
+last --hold seconds longer (default 2 x S), so a zero fits there and not at
+a return; capture with --trigger arrival.
 """
+
+
+BAR_HOLD = 8.0
+"""Seconds the bar model's robot stands at A (from the first reading) before it shuttles."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -159,6 +168,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     gauge.add_argument("--unit", default="mm", choices=("mm", "in"), help="unit (mm)")
     gauge.add_argument("--range", default="-12.5,12.5", metavar="LOW,HIGH", help="gauge range")
+    gauge.add_argument(
+        "--gauge-noise",
+        default="0.3",
+        metavar="R",
+        help="the indicators' own reading noise (sigma), in resolutions (0.3): readings at "
+        "rest scatter by it",
+    )
     motion = parser.add_argument_group("motion (fixture model)")
     motion.add_argument(
         "--cycle-period",
@@ -171,6 +187,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     motion.add_argument(
         "--overshoot", metavar="V", help="how far past its rest position the robot returns"
+    )
+    motion.add_argument(
+        "--hold",
+        metavar="S",
+        help="two-fixture, joints, gauge-bench: extra seconds at the rests where the procedure "
+        "zeroes (default 2 x the cycle period); bar: seconds at A before shuttling (8)",
     )
     motion.add_argument(
         "--hunt", default="0", metavar="V", help="amplitude of an axis that hunts at rest (0)"
@@ -252,32 +274,28 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
     if args.model == "fixture":
         return None
     resolution = bounded_number(args.resolution, "--resolution", 1e-6, 1.0)
+    gauge_noise = gauge_noise_of(args, resolution)
     if args.model == "gauge-bench":
         from station.instruments.gauge_bench import GaugeBenchModel
 
         bias = per_channel(args.bias, "--bias", ["x"])["x"]
         noise = per_channel(args.noise, "--noise", ["x"])["x"]
         reference = _float(args.reference, "--reference")
-        # The station reads one set to check the frames before a session, then a software
-        # zero reads one set on the plate; a device zero reads none there.
-        plate_readings = 0 if protocol.zero_command(protocol.channels[0]) else 2
         return GaugeBenchModel(
             reference,
             bias=bias,
             noise=noise,
-            gauge=GaugeSpec(resolution, -0.5, 1.0, "in"),
-            plate_readings=plate_readings,
+            gauge=GaugeSpec(resolution, -0.5, 1.0, "in", gauge_noise),
         )
     if args.model == "joints":
         from station.instruments.joint_model import JointModel, faulty_arm
 
         cycles = positive_number(args.cycles_per_joint, "--cycles-per-joint", int)
-        # A software zero reads one set at the taught position before each joint's returns.
-        home_readings = 0 if protocol.zero_command(protocol.channels[0]) else 1
+        # Each joint's turn starts with a rest at the taught position, where the station zeroes.
         options = {
             "cycles": cycles,
-            "gauge": GaugeSpec(resolution, -0.5, 0.5, "in"),
-            "home_readings": home_readings,
+            "gauge": GaugeSpec(resolution, -0.5, 0.5, "in", gauge_noise),
+            "home_readings": 1,
         }
         try:
             joint = int(args.faulty_joint)
@@ -295,20 +313,15 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
         if len(set(noise.values())) != 1:
             raise StationError("--noise: the two-fixture model takes one noise sigma for x, y, z.")
         reach_min, reach_max = _pair(args.reach, "--reach")
-        # A software zero reads one set at home per placement; a device zero reads none.
-        home_readings = 0 if protocol.zero_command(protocol.channels[0]) else 1
         return TwoFixtureModel(
             scale=tuple(scale[a] for a in axes),
             rotation=tuple(rotation[a] for a in axes),
             noise=noise["x"],
             reach_min=reach_min,
             reach_max=reach_max,
-            home_readings=home_readings,
             preload=_float(args.preload, "--preload"),
-            gauge=GaugeSpec(resolution, -0.5, 0.5, "in"),
+            gauge=GaugeSpec(resolution, -0.5, 0.5, "in", gauge_noise),
             seed=seed,
-            # The station reads one set to check the frames before the session starts.
-            lead_readings=1,
         )
     noise = per_channel(args.noise, "--noise", ["h", "v", "s"])
     try:
@@ -327,6 +340,11 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
         noise=noise["h"],
         indicator=GaugeSpec(resolution, -0.5, 0.5, "in"),
     )
+
+
+def gauge_noise_of(args: argparse.Namespace, resolution: float) -> float:
+    """The indicators' own noise (σ) in their unit, from ``--gauge-noise`` in resolutions."""
+    return _float(args.gauge_noise, "--gauge-noise", 0.0, 100.0) * resolution
 
 
 def build_simulator(args: argparse.Namespace):
@@ -376,7 +394,7 @@ def build_simulator(args: argparse.Namespace):
         ) from None
     resolution = bounded_number(args.resolution, "--resolution", 1e-6, 1.0)
     model = _procedure_model(args, protocol, seed) or FixtureModel(
-        axes, GaugeSpec(resolution, low, high, args.unit)
+        axes, GaugeSpec(resolution, low, high, args.unit, gauge_noise_of(args, resolution))
     )
     faults = Faults(
         garbage_rate=_rate(args.garbage_rate, "--garbage-rate"),
@@ -402,6 +420,11 @@ def build_simulator(args: argparse.Namespace):
             push_rate=push_rate,
             motion=build_motion(args, model, channels),
         )
+        if args.model == "bar":
+            # The robot stands still at A while the station zeroes, then shuttles.
+            simulator.leave_first_rest_after = (
+                _float(args.hold, "--hold", 0.0, 1e6) if args.hold is not None else BAR_HOLD
+            )
         # Every channel's frame must be writable at this resolution and range before serving.
         for device, channel in simulator.channel_map.items():
             protocol.wire_channel(device)
@@ -422,13 +445,14 @@ def build_simulator(args: argparse.Namespace):
 def build_motion(args: argparse.Namespace, model, channels: list[str]):
     """The :class:`~station.instruments.motion.CycleMotion` of ``--cycle-period`` (None
     without it)."""
-    from station.instruments.motion import CycleMotion, default_free_travel
+    from station.instruments.motion import CycleMotion, HeldRests, default_free_travel
 
     motion_flags = [
         flag
         for flag, value in (
             ("--free-travel", args.free_travel),
             ("--overshoot", args.overshoot),
+            ("--hold", args.hold if args.model != "bar" else None),
         )
         if value is not None
     ]
@@ -436,10 +460,14 @@ def build_motion(args: argparse.Namespace, model, channels: list[str]):
         if motion_flags:
             raise StationError(f"{motion_flags[0]} needs --cycle-period (the robot's rhythm).")
         return None
-    if args.model != "fixture":
+    if args.model == "bar":
         raise StationError(
-            f"--cycle-period moves the fixture model's robot; the {args.model} model has its "
-            "own motion."
+            "--cycle-period moves a robot between rests; the bar model's robot moves one point "
+            "per set sent (--push-rate)."
+        )
+    if args.hold is not None and args.model == "fixture":
+        raise StationError(
+            "--hold holds the rests where a procedure zeroes: two-fixture, joints or gauge-bench."
         )
     period = positive_number(args.cycle_period, "--cycle-period")
     gauge = model.gauge(channels[0])
@@ -455,20 +483,27 @@ def build_motion(args: argparse.Namespace, model, channels: list[str]):
     )
     hunt = {c: v for c, v in per_channel(args.hunt, "--hunt", channels).items() if v}
     hunt_every = positive_number(args.hunt_every, "--hunt-every", int)
-    return CycleMotion(period, free, abs(overshoot), hunt=hunt, hunt_every=hunt_every)
+    if args.model == "fixture":
+        return CycleMotion(period, free, abs(overshoot), hunt=hunt, hunt_every=hunt_every)
+    hold = _float(args.hold, "--hold", 0.0, 1e6) if args.hold is not None else 2 * period
+    # The rests where the procedure zeroes: home per placement, the taught position per joint,
+    # the plate once.
+    held_every = {
+        "two-fixture": lambda: model.rests_per_placement,
+        "joints": lambda: model.readings_per_joint,
+        "gauge-bench": lambda: 0,
+    }[args.model]()
+    return HeldRests(period, free, abs(overshoot), hold=hold, held_every=held_every)
 
 
 def show_pendant(simulator) -> None:
     """Print the teach pendant's display on stderr whenever the robot reaches another
     placement (two-fixture model): the operator of a headless capture types it in."""
     model = simulator.model
-    channels = tuple(simulator.channel_map.values())
     shown = [0]
 
     def on_sent(channel: str, k: int) -> None:
-        # The placement changes once every channel's reading of the last one is out.
-        sent = min(len(simulator.sent[c]) for c in channels)
-        number = model.current_placement(sent)
+        number = model.current_placement(_rest_of_last(simulator, channel))
         if number != shown[0]:
             shown[0] = number
             text = model.placement_of(number).pendant_text()
@@ -478,17 +513,21 @@ def show_pendant(simulator) -> None:
     simulator.on_sent = on_sent
 
 
+def _rest_of_last(simulator, channel: str) -> int:
+    """The robot's rest when ``channel``'s last frame was sent (its first rest before any)."""
+    sent = simulator.sent.get(channel) if channel else None
+    return int(sent[-1].cycle or 0) if sent else 0
+
+
 def show_joint(simulator) -> None:
     """Print on stderr which joint to move when its turn comes (joints model), with its lever
     arm (the distance from its axis to the cube, for the analysis)."""
     model = simulator.model
-    channels = tuple(simulator.channel_map.values())
     levers = model.lever_arms()
     shown = [0]
 
     def on_sent(channel: str, k: int) -> None:
-        sent = min(len(simulator.sent[c]) for c in channels)
-        number = model.current_joint(sent)
+        number = model.current_joint(_rest_of_last(simulator, channel))
         if number != shown[0]:
             shown[0] = number
             print(

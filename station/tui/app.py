@@ -458,7 +458,7 @@ class StationApp(App[int]):
         fixture = self.demo_fixture
         if fixture is not None:
             # The simulated robot goes where the procedure says (its pendant follows).
-            fixture.at_placement(notice.state.placement)
+            fixture.follow(notice.state)
         event_type = str((notice.event or {}).get("type", "")) if notice.event else ""
         sink = self.sample_sink
         if sink is not None and event_type == "samples":

@@ -25,7 +25,9 @@ class BarModel(RobotModel):
       of travel; a straightness fit removes it), a random offset per stroke (σ
       ``stroke_jitter``: the path does not repeat exactly) and reading noise (σ ``noise``).
 
-    The scale s reads the position with its own resolution and noise ``scale_noise``.
+    The scale s reads the position with its own resolution and noise ``scale_noise``. The
+    robot stands still at A while the station zeroes (the simulator's rest 0) and shuttles from
+    rest 1 on (:meth:`reading`).
     """
 
     channels = ("h", "v", "s")
@@ -108,6 +110,17 @@ class BarModel(RobotModel):
             + self.stroke_jitter * jitter
             + self.noise * rng.gauss(0.0, 1.0)
         )
+
+    moves_per_set = True
+
+    def reading(self, channel: str, rest: int, k: int, seed: int) -> float:
+        """Rest 0: the robot stands still at end A (the zero steps), its indicators showing
+        the stroke's start plus their own noise. From rest 1 it shuttles A→B→A…, one point per
+        set sent: the k-th reading of the rest (``k`` counted from its start) is the k-th
+        point."""
+        if rest <= 0:
+            return self.shown(channel, self.true_value(channel, 0, seed), k, seed)
+        return self.value(channel, k, seed)
 
     def value(self, channel: str, k: int, seed: int) -> float:
         """The k-th displayed reading of ``channel``."""

@@ -49,6 +49,9 @@ class GaugeSpec:
     low: float = -12.5
     high: float = 12.5
     unit: str = "mm"
+    noise: float = 0.0
+    """The indicator's own reading noise (σ, in its unit): what its readings scatter by while
+    the robot stands still (a few tenths of a resolution on a good indicator)."""
 
     def show(self, value: float) -> float:
         """``value`` as the gauge displays it: clipped to its range, at its resolution."""
@@ -63,22 +66,53 @@ INCH_INDICATOR = GaugeSpec(0.0001, -0.5, 0.5, "in")
 
 
 class RobotModel:
-    """The interface the server needs: channels, a gauge per channel, and the k-th value."""
+    """The interface the server needs: channels, a gauge per channel, and what each gauge
+    shows while the robot is at its ``rest``-th rest (0-based: the robot's state, stepped each
+    time it leaves and comes back).
+
+    At rest the robot is still: every reading of that rest is the same rest position plus the
+    indicator's own noise (:attr:`GaugeSpec.noise`), so a zero of several readings sees a gauge
+    at rest. The rest positions differ from rest to rest by the model's repeatability, bias,
+    drift and so on.
+    """
 
     channels: tuple[str, ...] = ()
+    moves_per_set: bool = False
+    """True for a model whose robot moves one point per set sent (a bar's strokes, a ramp):
+    its :meth:`reading` gets ``k`` counted from the start of the current rest."""
 
     def gauge(self, channel: str) -> GaugeSpec:
         """The indicator on ``channel``."""
         raise NotImplementedError
 
-    def value(self, channel: str, k: int, seed: int) -> float:
-        """What ``channel``'s gauge shows for its ``k``-th reading (0-based), for ``seed``."""
+    def value(self, channel: str, rest: int, seed: int) -> float:
+        """Where ``channel``'s gauge rests at the robot's ``rest``-th rest, as it shows it
+        (without the indicator's own noise)."""
         raise NotImplementedError
 
-    def zero_reference(self, channel: str, k_next: int, seed: int) -> float:
-        """What the gauge shows when its zero key is pressed before its ``k_next``-th reading:
-        by default the last value it showed (the first one before any)."""
-        return self.value(channel, max(k_next - 1, 0), seed)
+    def rest_position(self, channel: str, rest: int, seed: int) -> float:
+        """Where ``channel``'s indicator rests at the ``rest``-th rest, before quantisation."""
+        return self.value(channel, rest, seed)
+
+    def reading(self, channel: str, rest: int, k: int, seed: int) -> float:
+        """What ``channel``'s gauge shows for its ``k``-th reading, taken while the robot is at
+        its ``rest``-th rest: the rest position plus the indicator's noise (its own draw per
+        reading), at the gauge's resolution."""
+        return self.shown(channel, self.rest_position(channel, rest, seed), k, seed)
+
+    def shown(self, channel: str, position: float, k: int, seed: int) -> float:
+        """``position`` as ``channel``'s gauge shows it in its ``k``-th reading: with the
+        indicator's own noise (a draw of its own per reading), at its resolution."""
+        gauge = self.gauge(channel)
+        if gauge.noise:
+            index = self.channels.index(channel)
+            position += gauge.noise * random.Random(f"{seed}/gauge/{index}/{k}").gauss(0.0, 1.0)
+        return gauge.show(position)
+
+    def zero_reference(self, channel: str, rest: int, seed: int) -> float | None:
+        """What the gauge's zero key sets as its zero at the ``rest``-th rest, when the model
+        knows better than the gauge's last reading (None: the last reading it showed)."""
+        return None
 
 
 def skew_normal_unit(alpha: float, z0: float, z1: float) -> float:
@@ -115,7 +149,7 @@ class FixtureModel(RobotModel):
         return self._gauges[channel]
 
     def true_value(self, channel: str, k: int, seed: int) -> float:
-        """The indicator's reading before quantisation and clipping."""
+        """Where the indicator rests at the robot's k-th rest, before quantisation."""
         axis = self.axes[channel]
         index = self.channels.index(channel)
         # One generator per (seed, channel, k): the k-th value never depends on other draws.
@@ -134,8 +168,12 @@ class FixtureModel(RobotModel):
             )
         return value
 
+    def rest_position(self, channel: str, rest: int, seed: int) -> float:
+        """Where the indicator rests at the robot's ``rest``-th rest, before quantisation."""
+        return self.true_value(channel, rest, seed)
+
     def value(self, channel: str, k: int, seed: int) -> float:
-        """The k-th displayed reading of ``channel``."""
+        """The k-th rest position of ``channel`` as the gauge shows it."""
         return self.gauge(channel).show(self.true_value(channel, k, seed))
 
 
@@ -145,6 +183,8 @@ class RampModel(RobotModel):
     For checking a line end to end: a lost, invented or duplicated reading is visible by value
     (the reconnect tests and the reader benchmark use it).
     """
+
+    moves_per_set = True
 
     def __init__(
         self, channels: Sequence[str], gauge: GaugeSpec = GaugeSpec(), step: float | None = None
@@ -157,6 +197,10 @@ class RampModel(RobotModel):
     def gauge(self, channel: str) -> GaugeSpec:
         """The indicator on ``channel``."""
         return self._gauge
+
+    def reading(self, channel: str, rest: int, k: int, seed: int) -> float:
+        """Every reading its own value, whatever the robot does."""
+        return self.value(channel, k, seed)
 
     def value(self, channel: str, k: int, seed: int) -> float:
         """``low`` + ((k + channel index × 1000 + seed) mod span) × step, at the resolution."""

@@ -72,7 +72,7 @@ class SentFrame:
     frame: bytes
     t_mono: float
     cycle: int | None = None
-    """The robot's cycle when it was sent (a moving simulator); None otherwise."""
+    """The robot's rest (its cycle) when it was sent."""
 
 
 class Simulator:
@@ -96,6 +96,7 @@ class Simulator:
         push_rate: float = 0.0,
         answer_delay: float = 0.0,
         motion: CycleMotion | None = None,
+        returns_each_set: bool = False,
     ) -> None:
         self.protocol = protocol
         self.model = model
@@ -106,6 +107,20 @@ class Simulator:
         """The robot's round trips (:mod:`~station.instruments.motion`); None: every reading is
         a new rest position (the k-th reading of the model)."""
         self.motion_t0 = 0.0
+        self.rest = 0
+        self.returns_each_set = returns_each_set
+        """True: the still robot leaves and comes back between every two reading sets (a
+        robot paced exactly by the station's polls or DATA presses, for sessions without a
+        zero step: a zero of several readings is refused as moving)."""
+        self._rest_began: dict[str, int] = {}
+        self.leave_first_rest_after: float | None = None
+        """When set, the still robot leaves its first rest (for rest 1) this many seconds after
+        its first frame is sent: the bar's robot starts shuttling once the zeros are taken."""
+        self._first_read_at: float | None = None
+        """The still robot's state (no ``motion``): which rest it is at, 0 first; it stays there
+        however often the gauges are read, and steps on :meth:`robot_returns` /
+        :meth:`move_to_rest`. Every reading at a rest shows the model's rest position plus the
+        indicator's own noise."""
         """``time.monotonic()`` when serving started: the origin of the motion's time."""
         self.answer_delay = answer_delay
         if channel_map is None:
@@ -394,11 +409,13 @@ class Simulator:
         gauge = self.model.gauge(channel)
         k = self._k[channel]
         now = time.monotonic()
-        cycle = None
         if self.motion is not None:
             cycle = self.motion.stage(now - self.motion_t0)[0]
-            value = self.expected_at(channel, now)
+            value = self.expected_at(channel, now, k)
         else:
+            if self.leave_first_rest_after is not None and self.rest == 0:
+                self._leave_first_rest(now)
+            cycle = k if self.returns_each_set else self.rest
             value = self.expected(channel, k)
         frame = self.protocol.encode(device, value, gauge.resolution, gauge.unit)
         if garbage:
@@ -426,50 +443,94 @@ class Simulator:
 
     # -- for tests and the demo ---------------------------------------------------------
 
+    def robot_returns(self, times: int = 1) -> int:
+        """The still robot leaves and comes back ``times`` times (to its next rest); returns
+        the rest it is at now. A moving simulator's robot follows its motion instead."""
+        if self.motion is not None:
+            raise StationError("this simulator's robot moves by itself (it has a cycle period)")
+        with self._lock:
+            self._set_rest(self.rest + times)
+            return self.rest
+
+    def move_to_rest(self, rest: int) -> None:
+        """Put the still robot at its ``rest``-th rest (whoever plays the robot: the demo
+        following the procedure's steps, a test)."""
+        if self.motion is not None:
+            raise StationError("this simulator's robot moves by itself (it has a cycle period)")
+        with self._lock:
+            self._set_rest(max(0, int(rest)))
+
+    def _set_rest(self, rest: int) -> None:
+        if rest != self.rest:
+            self.rest = rest
+            # A model that moves per set counts its sets from the start of the rest.
+            self._rest_began = dict(self._k)
+
     def expected(self, channel: str, k: int) -> float:
-        """The value the k-th reading of ``channel`` shows (sent or not), after any zeroing."""
-        value = self.model.value(channel, k, self.seed)
+        """The value the k-th reading of ``channel`` shows (sent or not) with the still robot
+        at its current rest, after any zeroing."""
+        if self.returns_each_set:
+            return self._zeroed(channel, self.model.reading(channel, k, k, self.seed))
+        if self.model.moves_per_set:
+            k -= self._rest_began.get(channel, 0)
+        return self._zeroed(channel, self.model.reading(channel, self.rest, k, self.seed))
+
+    def _leave_first_rest(self, now: float) -> None:
+        """Time the first rest from the first reading; leave it once it has lasted."""
+        if self._first_read_at is None:
+            self._first_read_at = now
+        elif now - self._first_read_at >= self.leave_first_rest_after:
+            self._set_rest(1)
+
+    def _zeroed(self, channel: str, value: float) -> float:
         offset = self.zero_offsets.get(channel)
         if offset is None:
             return value
         return self.model.gauge(channel).show(value - offset)
 
     def _zero(self, channel: str) -> None:
-        """The device's zero key: what it shows now (its last reading) becomes 0."""
+        """The device's zero key: what it shows now (its last reading) becomes 0, unless the
+        model knows the fixture's own zero (a preload, a surface plate)."""
         self.zero_requests.append(channel)
         if self.motion is not None:
             # A moving robot's gauge zeroes on what it shows at this instant.
             self.zero_offsets[channel] = self.shown_at(channel, time.monotonic())
             return
-        self.zero_offsets[channel] = self.model.zero_reference(channel, self._k[channel], self.seed)
+        reference = self.model.zero_reference(channel, self.rest, self.seed)
+        if reference is None:
+            last = self.sent[channel][-1].value if self.sent[channel] else None
+            shown = self.model.reading(channel, self.rest, self._k[channel], self.seed)
+            # The frame sent last is already zeroed by any earlier zero: undo that.
+            reference = shown if last is None else last + self.zero_offsets.get(channel, 0.0)
+        self.zero_offsets[channel] = reference
 
     def rest_value(self, channel: str, cycle: int) -> float:
-        """Where ``channel``'s indicator comes to rest in ``cycle`` (a moving simulator), as
-        the gauge shows it before any zero: the model's ``cycle``-th value."""
+        """Where ``channel``'s indicator comes to rest in ``cycle``, as the gauge shows it
+        before any zero (without the indicator's own noise): the model's ``cycle``-th rest."""
         return self.model.value(channel, cycle, self.seed)
 
-    def shown_at(self, channel: str, t_mono: float) -> float:
-        """What ``channel``'s gauge shows at ``t_mono`` (a moving simulator), before any zero."""
+    def shown_at(self, channel: str, t_mono: float, k: int | None = None) -> float:
+        """What ``channel``'s gauge shows at ``t_mono`` (a moving simulator), before any zero;
+        with ``k``, the indicator's own noise of its k-th reading on top."""
         motion = self.motion
         if motion is None:
             raise StationError("this simulator does not move (no cycle period)")
         cycle = motion.stage(t_mono - self.motion_t0)[0]
-        exact = getattr(self.model, "true_value", self.model.value)
+        model = self.model
         position = motion.position(
             channel,
             t_mono - self.motion_t0,
-            exact(channel, cycle, self.seed),
-            exact(channel, cycle + 1, self.seed),
+            model.rest_position(channel, cycle, self.seed),
+            model.rest_position(channel, cycle + 1, self.seed),
         )
-        return self.model.gauge(channel).show(position)
+        if k is None:
+            return model.gauge(channel).show(position)
+        return model.shown(channel, position, k, self.seed)
 
-    def expected_at(self, channel: str, t_mono: float) -> float:
-        """What ``channel``'s gauge shows at ``t_mono`` after any zeroing (a moving simulator)."""
-        value = self.shown_at(channel, t_mono)
-        offset = self.zero_offsets.get(channel)
-        if offset is None:
-            return value
-        return self.model.gauge(channel).show(value - offset)
+    def expected_at(self, channel: str, t_mono: float, k: int | None = None) -> float:
+        """What ``channel``'s gauge shows at ``t_mono`` after any zeroing (a moving simulator);
+        with ``k``, with the indicator's own noise of its k-th reading."""
+        return self._zeroed(channel, self.shown_at(channel, t_mono, k))
 
     def sent_values(self, channel: str) -> list[float]:
         """The values sent so far on ``channel``, in order."""

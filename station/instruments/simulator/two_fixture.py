@@ -39,18 +39,19 @@ class TwoFixtureModel(RobotModel):
     (``rotation``, radians about x, y, z: the error ω × P), both growing with the distance moved,
     plus a constant ``bias`` and repeatability ``noise`` (σ) per reading.
 
-    Each placement is ``home_readings`` readings at home (the indicators show their preload,
-    seeded per placement and axis within ±``preload``, plus noise) followed by ``captures``
-    readings after the return (preload + error + noise); the k-th reading belongs to placement
-    ``k // (home_readings + captures) + 1`` unless :attr:`placement` is set (a runner or the
-    autopilot that knows which placement it is at). :meth:`placement_of` gives the pendant
-    display to type in.
+    The model follows the robot's state, not the readings: each placement is one rest at home
+    (the first fixture's indicators show their preload, seeded per placement and axis within
+    ±``preload``; the station zeroes there, from as many readings as it likes) followed by
+    ``captures`` rests after returns from the second fixture (preload + error). Rest ``r`` (the
+    simulator's robot state: stepped as the robot leaves and comes back, by its motion in time
+    or by whoever plays the robot) belongs to placement ``r // (1 + captures) + 1``;
+    :meth:`rest_of` gives the rest of a placement's home or return, :meth:`placement_of` the
+    pendant display to type in. However many sets the station reads at a rest (the frames check,
+    a zero of several readings), they all read that rest. The repeatability ``noise`` (σ) is
+    drawn per rest; the indicator's own noise (its :class:`GaugeSpec`) per reading.
 
-    Zeroing at the first fixture must take out the preload and nothing else: a software zero
-    reads the home readings (so a procedure run with a software-zero protocol wants
-    ``home_readings=1``: its zero step reads one set per placement); a device zero
-    (:meth:`zero_reference`) takes the placement's preload itself, with no reading
-    (``home_readings=0``). Either way the capture after the return shows the placement's error.
+    Zeroing at home takes out the preload and nothing else: a software zero reads the home rest;
+    a device zero (:meth:`zero_reference`) takes the placement's preload itself.
     """
 
     channels = ("x", "y", "z")
@@ -65,12 +66,10 @@ class TwoFixtureModel(RobotModel):
         reach_min: float = 10.0,
         reach_max: float = 40.0,
         captures: int = 1,
-        home_readings: int = 0,
         preload: float = 0.0,
         pendant_resolution: float = 0.001,
         gauge: GaugeSpec = INCH_INDICATOR,
         seed: int = 0,
-        lead_readings: int = 0,
     ) -> None:
         if captures < 1:
             raise StationError(f"captures per placement must be 1 or more, not {captures}.")
@@ -81,19 +80,13 @@ class TwoFixtureModel(RobotModel):
         self.bias = tuple(float(v) for v in bias)
         self.noise = float(noise)
         self.reach = (float(reach_min), float(reach_max))
-        if home_readings < 0 or preload < 0:
-            raise StationError("home readings and the preload must not be negative.")
+        if preload < 0:
+            raise StationError("the preload must not be negative.")
         self.captures = int(captures)
-        self.home_readings = int(home_readings)
         self.preload = float(preload)
         self.pendant_resolution = float(pendant_resolution)
         self._gauge = gauge
         self.seed = seed
-        self.lead_readings = max(0, int(lead_readings))
-        """Readings at home before the first placement begins (the station reads one set to
-        check the gauges' frames before a session starts)."""
-        self.placement: int | None = None
-        """The placement the robot is at now; None: derived from the reading index."""
 
     def gauge(self, channel: str) -> GaugeSpec:
         """The indicator on ``channel``."""
@@ -123,21 +116,27 @@ class TwoFixtureModel(RobotModel):
         )
 
     @property
-    def readings_per_placement(self) -> int:
-        """Readings of each channel per placement: at home, then after the return."""
-        return self.home_readings + self.captures
+    def rests_per_placement(self) -> int:
+        """The robot's rests per placement: one at home, then one per return."""
+        return 1 + self.captures
 
-    def current_placement(self, k: int) -> int:
-        """The placement of the k-th reading."""
-        if self.placement is not None:
-            return self.placement
-        return max(k - self.lead_readings, 0) // self.readings_per_placement + 1
+    def current_placement(self, rest: int) -> int:
+        """The placement (1-based) of the robot's ``rest``-th rest."""
+        return max(rest, 0) // self.rests_per_placement + 1
 
-    def at_home(self, k: int) -> bool:
-        """True when the k-th reading is taken at home (before the round trip)."""
-        if k < self.lead_readings:
-            return True
-        return (k - self.lead_readings) % self.readings_per_placement < self.home_readings
+    def at_home(self, rest: int) -> bool:
+        """True when the ``rest``-th rest is at home (before the round trip)."""
+        return max(rest, 0) % self.rests_per_placement == 0
+
+    def rest_of(self, placement: int, returned: int = 0) -> int:
+        """The rest at home of ``placement`` (``returned`` 0), or after its ``returned``-th
+        return (1, 2, ...)."""
+        if placement < 1 or not 0 <= returned <= self.captures:
+            raise StationError(
+                f"placement {placement} has a rest at home and {self.captures} after returns, "
+                f"not return {returned}."
+            )
+        return (placement - 1) * self.rests_per_placement + returned
 
     def preload_of(self, number: int) -> tuple[float, float, float]:
         """How far the cube depresses each indicator at placement ``number``, about its mid
@@ -145,20 +144,24 @@ class TwoFixtureModel(RobotModel):
         rng = random.Random(f"preload/{self.seed}/{number}")
         return tuple(rng.uniform(-self.preload, self.preload) for _ in range(3))  # type: ignore[return-value]
 
-    def true_value(self, channel: str, k: int, seed: int) -> float:
-        """The indicator's reading before quantisation and clipping."""
+    def true_value(self, channel: str, rest: int, seed: int) -> float:
+        """Where the indicator rests at the ``rest``-th rest, before quantisation."""
         index = self.channels.index(channel)
-        rng = random.Random(f"{seed}/{index}/{k}")
-        number = self.current_placement(k)
-        error = 0.0 if self.at_home(k) else self.systematic_error(number)[index]
+        rng = random.Random(f"{seed}/{index}/{rest}")
+        number = self.current_placement(rest)
+        error = 0.0 if self.at_home(rest) else self.systematic_error(number)[index]
         return self.preload_of(number)[index] + error + self.noise * rng.gauss(0.0, 1.0)
 
-    def zero_reference(self, channel: str, k_next: int, seed: int) -> float:
+    def rest_position(self, channel: str, rest: int, seed: int) -> float:
+        """Where the indicator rests at the ``rest``-th rest, before quantisation."""
+        return self.true_value(channel, rest, seed)
+
+    def zero_reference(self, channel: str, rest: int, seed: int) -> float:
         """A device zero at the first fixture takes the placement's preload: the robot is at
         home, so the indicator shows no error there."""
-        number = self.current_placement(k_next)
+        number = self.current_placement(rest)
         return self._gauge.show(self.preload_of(number)[self.channels.index(channel)])
 
-    def value(self, channel: str, k: int, seed: int) -> float:
-        """The k-th displayed reading of ``channel``."""
-        return self._gauge.show(self.true_value(channel, k, seed))
+    def value(self, channel: str, rest: int, seed: int) -> float:
+        """The ``rest``-th rest position of ``channel`` as the gauge shows it."""
+        return self._gauge.show(self.true_value(channel, rest, seed))
