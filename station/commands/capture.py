@@ -32,7 +32,7 @@ protocol; the session is in inches at 0.0001"); with ``--trigger push`` press DA
 the check waits ``--timeout`` and leaves it to the zero step, which checks the unit too).
 
 Pacing: ``--trigger poll`` needs ``--every S`` (at least S seconds between two cycles, and
-after a zero) or a terminal (Enter per cycle, after a prompt naming the cycle the file will
+around a zero) or a terminal (Enter per cycle, after a prompt naming the cycle the file will
 record); without either it is refused before anything is written. ``--trigger arrival`` (the
 repeatability procedure's default on a polled protocol) reads the gauges continuously and takes
 a set each time the robot leaves the fixture and comes back to rest; a return that does not
@@ -138,7 +138,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--every",
         metavar="S",
-        help="poll: at least S seconds between two cycles and after a zero (without it, and "
+        help="poll: at least S seconds between two cycles and around a zero (without it, and "
         "without a terminal to press Enter in, poll is refused)",
     )
     parser.add_argument(
@@ -585,6 +585,11 @@ class _Headless:
     def _zero(self, state: Any) -> None:
         from station.instruments.zeroing import GaugesMoving
 
+        if self.every is not None:
+            # After a capture the robot is brought to where it is zeroed: --every paces that too.
+            delay = self._last_capture + self.every - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
         seen = self._readings_seen()
         try:
             self.runner.zero(by=BY, timeout=self.timeout)

@@ -42,8 +42,8 @@ others):
                scale's counter send every set by themselves at --push-rate sets
                per second (default 200, as a counter's continuous output does):
                capture with --trigger push. The robot stands still at A for
-               --hold seconds (default 8) from the first frame it sends, where the
-               station zeroes, then advances one point per set sent.
+               --hold seconds (default 8) from the first frame it sends, where
+               the station zeroes, then advances one point per set sent.
   joints       per-joint troubleshooting (report 1.2, 2.8): x, y, z in inches
                at the fixture of a 3-joint arm (base, shoulder, elbow), each
                joint moved alone for --cycles-per-joint returns in turn (joint
@@ -63,19 +63,22 @@ others):
 The models follow the robot's state, not the readings: at each rest every
 reading shows the same rest position plus the indicators' own noise
 (--gauge-noise, in resolutions), however often the station reads it. Without
---cycle-period the robot stays at its first rest. --cycle-period S makes the
-robot leave the fixture and come back every S seconds, as a playback loop
-does: at rest (the model's bias, noise, drift and backlash for that cycle),
-then the indicators run out to their free travel (--free-travel, default
--3/8 in or -9.525 mm) while the robot is away, then it returns with a short
-overshoot (--overshoot, default 20 resolutions) and settles. The c-th rest
-position is the model's c-th value; a reading shows where the robot is when
-it is sent. --hunt CH=V makes an axis hunt by +-V at rest on every --hunt-
-every N-th return instead of settling (a return the station must report, not
-record). With two-fixture, joints and gauge-bench the rests where the
-procedure zeroes (home, the taught position before each joint, the plate)
-last --hold seconds longer (default 2 x S), so a zero fits there and not at
-a return; capture with --trigger arrival.
+--cycle-period the robot moves to its next rest whenever the station has not
+polled it for --return-gap seconds (1), as a technician moves the robot
+while the station waits: pace `station capture --trigger poll` with --every
+above the gap, and the readings of one zero stay at one rest. The next rest
+is the next return at one fixture; with two-fixture, the placement's return
+after its home, then the next home; with joints, the next return or the next
+joint's taught position; with gauge-bench, the plate and then each seating
+of the block. --cycle-period S makes the fixture model's robot leave the
+fixture and come back every S seconds, as a playback loop does: at rest (the
+model's bias, noise, drift and backlash for that cycle), then the indicators
+run out to their free travel (--free-travel, default -3/8 in or -9.525 mm)
+while the robot is away, then it returns with a short overshoot
+(--overshoot, default 20 resolutions) and settles. The c-th rest position is
+the model's c-th value; a reading shows where the robot is when it is sent.
+--hunt CH=V makes an axis hunt by +-V at rest on every --hunt-every N-th
+return instead of settling (a return the station must report, not record).
 """
 
 
@@ -189,10 +192,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--overshoot", metavar="V", help="how far past its rest position the robot returns"
     )
     motion.add_argument(
-        "--hold",
+        "--return-gap",
+        default="1",
         metavar="S",
-        help="two-fixture, joints, gauge-bench: extra seconds at the rests where the procedure "
-        "zeroes (default 2 x the cycle period); bar: seconds at A before shuttling (8)",
+        help="without --cycle-period: the robot moves to its next rest whenever the station "
+        "has not polled for S seconds (1; 0 = never), so pace polls with --every above S",
+    )
+    motion.add_argument(
+        "--hold", metavar="S", help="bar: seconds the robot stands at A before shuttling (8)"
     )
     motion.add_argument(
         "--hunt", default="0", metavar="V", help="amplitude of an axis that hunts at rest (0)"
@@ -338,7 +345,7 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
         wobble_v=_float(args.wobble_v, "--wobble-v"),
         period=_float(args.period, "--period"),
         noise=noise["h"],
-        indicator=GaugeSpec(resolution, -0.5, 0.5, "in"),
+        indicator=GaugeSpec(resolution, -0.5, 0.5, "in", gauge_noise),
     )
 
 
@@ -420,6 +427,9 @@ def build_simulator(args: argparse.Namespace):
             push_rate=push_rate,
             motion=build_motion(args, model, channels),
         )
+        if simulator.motion is None and args.model != "bar":
+            # The operator moves the robot while the station waits between its steps.
+            simulator.return_gap = _float(args.return_gap, "--return-gap", 0.0, 1e6) or None
         if args.model == "bar":
             # The robot stands still at A while the station zeroes, then shuttles.
             simulator.leave_first_rest_after = (
@@ -445,14 +455,13 @@ def build_simulator(args: argparse.Namespace):
 def build_motion(args: argparse.Namespace, model, channels: list[str]):
     """The :class:`~station.instruments.motion.CycleMotion` of ``--cycle-period`` (None
     without it)."""
-    from station.instruments.motion import CycleMotion, HeldRests, default_free_travel
+    from station.instruments.motion import CycleMotion, default_free_travel
 
     motion_flags = [
         flag
         for flag, value in (
             ("--free-travel", args.free_travel),
             ("--overshoot", args.overshoot),
-            ("--hold", args.hold if args.model != "bar" else None),
         )
         if value is not None
     ]
@@ -460,14 +469,10 @@ def build_motion(args: argparse.Namespace, model, channels: list[str]):
         if motion_flags:
             raise StationError(f"{motion_flags[0]} needs --cycle-period (the robot's rhythm).")
         return None
-    if args.model == "bar":
+    if args.model != "fixture":
         raise StationError(
-            "--cycle-period moves a robot between rests; the bar model's robot moves one point "
-            "per set sent (--push-rate)."
-        )
-    if args.hold is not None and args.model == "fixture":
-        raise StationError(
-            "--hold holds the rests where a procedure zeroes: two-fixture, joints or gauge-bench."
+            f"--cycle-period moves the fixture model's robot; the {args.model} model's robot "
+            "moves where its procedure's steps take it (see --return-gap)."
         )
     period = positive_number(args.cycle_period, "--cycle-period")
     gauge = model.gauge(channels[0])
@@ -483,17 +488,7 @@ def build_motion(args: argparse.Namespace, model, channels: list[str]):
     )
     hunt = {c: v for c, v in per_channel(args.hunt, "--hunt", channels).items() if v}
     hunt_every = positive_number(args.hunt_every, "--hunt-every", int)
-    if args.model == "fixture":
-        return CycleMotion(period, free, abs(overshoot), hunt=hunt, hunt_every=hunt_every)
-    hold = _float(args.hold, "--hold", 0.0, 1e6) if args.hold is not None else 2 * period
-    # The rests where the procedure zeroes: home per placement, the taught position per joint,
-    # the plate once.
-    held_every = {
-        "two-fixture": lambda: model.rests_per_placement,
-        "joints": lambda: model.readings_per_joint,
-        "gauge-bench": lambda: 0,
-    }[args.model]()
-    return HeldRests(period, free, abs(overshoot), hold=hold, held_every=held_every)
+    return CycleMotion(period, free, abs(overshoot), hunt=hunt, hunt_every=hunt_every)
 
 
 def show_pendant(simulator) -> None:
@@ -583,6 +578,8 @@ def run(args: argparse.Namespace) -> int:
             + (
                 f"; the robot leaves the fixture and returns every {simulator.motion.period:g} s"
                 if simulator.motion is not None
+                else "; the robot stays at rest (--cycle-period moves it)"
+                if args.model != "bar"
                 else ""
             )
             + "; Ctrl-C stops",

@@ -138,83 +138,9 @@ class CycleMotion:
         return self.hunt[channel] * math.sin(2.0 * math.pi * t / self.hunt_period)
 
 
-@dataclass(frozen=True)
-class HeldRests(CycleMotion):
-    """Round trips where some rests last longer: the rests where the procedure zeroes.
-
-    A relative-accuracy robot stays at home at the first fixture while the station zeroes,
-    then makes its round trip to the second fixture and back, where one set is taken, then
-    leaves for the next placement; a gauge bench's spindle rests on the surface plate for the
-    zero, then the block is re-seated for every reading. Every rest ``c`` with ``c %
-    held_every == 0`` (only rest 0 when ``held_every`` is 0) is held ``hold`` seconds more than
-    the others; everything else is :class:`CycleMotion`'s round trip. A zero (a second or so
-    of readings) then fits only where it belongs: the short rests leave time for a set but not
-    for a zero, which is refused as moving there and taken at the next held rest.
-    """
-
-    hold: float = 2.0
-    held_every: int = 0
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if self.hold < 0 or self.held_every < 0:
-            raise StationError("A held rest's time and its spacing must not be negative.")
-
-    def held(self, cycle: int) -> bool:
-        """True when rest ``cycle`` is held longer (a zero is taken there)."""
-        return cycle == 0 if self.held_every == 0 else cycle % self.held_every == 0
-
-    def _length(self, cycle: int) -> float:
-        return self.period + (self.hold if self.held(cycle) else 0.0)
-
-    def _start(self, cycle: int) -> float:
-        """When rest ``cycle`` begins, in seconds since the start."""
-        if self.held_every == 0:
-            return cycle * self.period + (self.hold if cycle > 0 else 0.0)
-        held_before = (cycle + self.held_every - 1) // self.held_every
-        return cycle * self.period + held_before * self.hold
-
-    def stage(self, t: float) -> tuple[int, Stage, float]:
-        """The cycle at ``t``, its stage and how far into it (the held rest's extra time is
-        spent at rest)."""
-        t = max(t, 0.0)
-        cycle = max(int(t // (self.period + self.hold)) - 1, 0)
-        while self._start(cycle + 1) <= t:
-            cycle += 1
-        within = t - self._start(cycle)
-        extra = self._length(cycle) - self.period
-        rest = self.dwell * self.period + extra
-        if within < rest:
-            return cycle, "at rest", within / rest
-        _, name, u = super().stage(within - extra)
-        return cycle, name, u
-
-    def rest_window(self, cycle: int) -> tuple[float, float]:
-        """When rest ``cycle`` is shown, in seconds since the start."""
-        start = self._start(cycle)
-        return start, start + self.dwell * self.period + self._length(cycle) - self.period
-
-    def position(self, channel: str, t: float, rest: float, next_rest: float) -> float:
-        """As :meth:`CycleMotion.position`, on this timeline."""
-        cycle, stage, u = self.stage(t)
-        if stage == "at rest":
-            return rest + self._hunting(channel, cycle, t)
-        within = t - self._start(cycle) - (self._length(cycle) - self.period)
-        plain = CycleMotion(
-            self.period,
-            self.free_travel,
-            self.overshoot,
-            self.dwell,
-            self.depart,
-            self.away,
-            self.approach,
-        )
-        return plain.position(channel, within, rest, next_rest)
-
-
 def default_free_travel(unit: str) -> float:
     """The free travel in ``unit``: −3/8 in, or −9.525 mm."""
     return FREE_TRAVEL_INCHES * (25.4 if unit == "mm" else 1.0)
 
 
-__all__ = ["CycleMotion", "DEFAULT_FRACTIONS", "HeldRests", "Stage", "default_free_travel"]
+__all__ = ["CycleMotion", "DEFAULT_FRACTIONS", "Stage", "default_free_travel"]

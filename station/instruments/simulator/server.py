@@ -107,6 +107,13 @@ class Simulator:
         """The robot's round trips (:mod:`~station.instruments.motion`); None: every reading is
         a new rest position (the k-th reading of the model)."""
         self.motion_t0 = 0.0
+        self.return_gap: float | None = None
+        """When set (a still robot, polled): the operator moves the robot to its next rest
+        whenever the station has not asked for a reading for this many seconds, as a technician
+        moves the robot while the station waits between its steps (``station capture --every``
+        longer than the gap). The readings of one zero, or of the frames check, come closer
+        together: one rest."""
+        self._last_request: float | None = None
         self.rest = 0
         self.returns_each_set = returns_each_set
         """True: the still robot leaves and comes back between every two reading sets (a
@@ -342,6 +349,7 @@ class Simulator:
                 for device in devices:
                     self._zero(self.channel_map[device])
                 continue
+            self._asked(time.monotonic())
             if self.answer_delay:
                 time.sleep(self.answer_delay)
             for device in devices:
@@ -474,6 +482,13 @@ class Simulator:
         if self.model.moves_per_set:
             k -= self._rest_began.get(channel, 0)
         return self._zeroed(channel, self.model.reading(channel, self.rest, k, self.seed))
+
+    def _asked(self, now: float) -> None:
+        """A request arrived at ``now``: after a pause of ``return_gap`` the robot has moved."""
+        gap = self.return_gap
+        last, self._last_request = self._last_request, now
+        if gap and self.motion is None and last is not None and now - last >= gap:
+            self._set_rest(self.rest + 1)
 
     def _leave_first_rest(self, now: float) -> None:
         """Time the first rest from the first reading; leave it once it has lasted."""
