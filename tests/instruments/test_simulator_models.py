@@ -7,6 +7,7 @@ import math
 import os
 import select
 import time
+import tty
 
 import numpy as np
 import pytest
@@ -85,6 +86,7 @@ def test_the_simulator_serves_the_bar_and_the_strokes_come_back():
     sim = Simulator(protocol, model, seed=7)
     path = sim.start_pty()
     fd = os.open(path, os.O_RDWR | os.O_NOCTTY)
+    sim.move_to_rest(1)  # the strokes: the robot shuttles, one point per set sent
     sets = 4 * model.readings_per_stroke + model.dwell
     try:
         for _ in range(0, sets, 22):
@@ -202,3 +204,32 @@ def test_extra_reads_at_home_never_shift_which_fixture_is_read():
         assert set(home[channel]) == {model.value(channel, model.rest_of(1), 4)}
         assert back[channel] == [model.value(channel, model.rest_of(1, 1), 4)]
         assert set(next_home[channel]) == {model.value(channel, model.rest_of(2), 4)}
+
+
+def request_set(fd: int, protocol, sim: Simulator) -> dict[str, list[float]]:
+    """Poll every channel once, as the station does, and parse the answers."""
+    for request in dict.fromkeys(protocol.request(device) for device in sim.channel_map):
+        os.write(fd, request)
+    return by_channel(sim, read_values(fd, protocol, 3))
+
+
+def test_a_pause_in_the_polls_is_the_operator_moving_the_robot():
+    """``station simulate``'s still robot: polls close together (the frames check, a zero's
+    readings) read one rest; after a pause of ``return_gap`` the robot is at its next rest (the
+    placement's return, then the next placement's home)."""
+    protocol, model, sim, fd = serve_two_fixtures()
+    sim.return_gap = 0.3
+    try:
+        tty.setraw(fd)
+        home = [request_set(fd, protocol, sim) for _ in range(6)]  # frames check + a zero
+        time.sleep(0.4)
+        back = request_set(fd, protocol, sim)
+        time.sleep(0.4)
+        next_home = request_set(fd, protocol, sim)
+    finally:
+        os.close(fd)
+        sim.stop()
+    for channel in ("x", "y", "z"):
+        assert {s[channel][0] for s in home} == {model.value(channel, model.rest_of(1), 4)}
+        assert back[channel] == [model.value(channel, model.rest_of(1, 1), 4)]
+        assert next_home[channel] == [model.value(channel, model.rest_of(2), 4)]
