@@ -123,6 +123,16 @@ class JointModel(RobotModel):
         """Readings of each channel per joint: at the taught position, then the returns."""
         return self.home_readings + self.cycles
 
+    def rest_of(self, joint: int, returned: int = 0) -> int:
+        """The rest at the taught position before ``joint``'s returns (``returned`` 0), or of
+        its ``returned``-th return (1, 2, ...; needs ``home_readings`` 1)."""
+        if not 1 <= joint <= JOINTS or not 0 <= returned <= self.cycles:
+            raise StationError(
+                f"joint {joint} has a rest at the taught position and {self.cycles} returns, "
+                f"not return {returned}."
+            )
+        return (joint - 1) * self.readings_per_joint + returned + self.home_readings - 1
+
     def current_joint(self, k: int) -> int:
         """The joint (1-based) whose block the k-th reading belongs to."""
         if self.joint is not None:

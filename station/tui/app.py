@@ -34,6 +34,7 @@ from textual.geometry import Size
 
 from station.errors import StationError
 from station.plain import plain
+from station.tui.instruments import running_fixture
 from station.tui.messages import RunnerChanged
 from station.tui.remedies import explained
 
@@ -339,7 +340,7 @@ class StationApp(App[int]):
     def _find_demo_fixture(self, setup: SessionSetup) -> None:
         lab = self.config.demo_lab
         urls = [port.url for port in setup.ports]
-        found = [lab.by_url(url) for url in urls] if lab is not None else []
+        found = [lab.by_url(url) if lab is not None else running_fixture(url) for url in urls]
         self.demo_fixture = next((f for f in found if f is not None), None)
 
     def start_session(self, setup: SessionSetup) -> None:

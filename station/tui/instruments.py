@@ -65,7 +65,10 @@ class DemoFixture:
             # The bar's robot stands at its end for the zeros and shuttles for the strokes.
             rest = 1 if state.action.kind == "stream" else 0
         elif hasattr(model, "rest_of"):
-            rest = model.rest_of(state.placement or 1, 1 if capturing else 0)
+            # Blocks of a rest where the station zeroes, then returns (two fixtures: one).
+            done = state.progress.done if state.progress is not None else 0
+            returned = min(done + 1, getattr(model, "cycles", 1)) if capturing else 0
+            rest = model.rest_of(state.placement or 1, returned)
         elif isinstance(state.next_cycle, int) and capturing:
             rest = state.next_cycle
         elif state.action.kind in ("zero", "confirm", "input"):
@@ -77,7 +80,25 @@ class DemoFixture:
 
     def stop(self) -> None:
         """Close the pseudo-terminal and stop the simulator's thread."""
+        _RUNNING.pop(self.url, None)
         self.simulator.stop()
+
+
+_RUNNING: dict[str, DemoFixture] = {}
+"""The simulated set-ups started in this process, by URL: a session on one of them moves its
+robot where the steps say (:meth:`DemoFixture.follow`)."""
+
+
+def track(fixture: DemoFixture) -> DemoFixture:
+    """Follow ``fixture`` (a simulated set-up started in this process) in the sessions that
+    use its URL, until it stops."""
+    _RUNNING[fixture.url] = fixture
+    return fixture
+
+
+def running_fixture(url: str) -> DemoFixture | None:
+    """The simulated set-up started in this process that serves ``url``, if any."""
+    return _RUNNING.get(url)
 
 
 def start_demo_fixture(
@@ -151,7 +172,7 @@ def start_demo_fixture(
         protocol, model, seed=seed, channel_map=channel_map, push_rate=push_rate, motion=motion
     )
     url = simulator.start_pty(link=link)
-    return DemoFixture(
+    fixture = DemoFixture(
         url=url,
         protocol=DEMO_PROTOCOL,
         channel_map=dict(channel_map),
@@ -160,6 +181,7 @@ def start_demo_fixture(
         trigger=trigger,
         description=description,
     )
+    return track(fixture)
 
 
 class DemoLab:
