@@ -120,6 +120,19 @@ def assert_zeros_of_several_readings(zeroes, channels, expected_count: int) -> N
             assert len(entry["values"]) == entry["n"]
 
 
+def setup_of(procedure: str, simulator: Simulator, trigger: str = "poll") -> SessionSetup:
+    """A session of the built-in ``procedure`` on ``simulator``'s line, short counts."""
+    return SessionSetup(
+        procedure=discover_procedures(use_env=False).get(procedure),
+        robot="KSC-7",
+        operator="tester",
+        ports=(PortSetup(simulator.url, simulator.protocol.name, dict(simulator.channel_map)),),
+        trigger=trigger,
+        placements=2,
+        cycles=2,
+    )
+
+
 @pytest.mark.parametrize(
     ("procedure", "zeros"),
     [
@@ -133,34 +146,16 @@ def assert_zeros_of_several_readings(zeroes, channels, expected_count: int) -> N
 def test_every_zero_of_a_polled_session_is_a_mean_of_several_readings(
     tmp_path: Path, serve, gauges_for, procedure: str, zeros: int
 ) -> None:
-    catalog = discover_procedures(use_env=False)
-    model = model_for(procedure)
-    simulator = serve(model)
-    channels = catalog.get(procedure).channels
-    setup = SessionSetup(
-        procedure=catalog.get(procedure),
-        robot="KSC-7",
-        operator="tester",
-        ports=(PortSetup(simulator.url, "mitutoyo", dict(simulator.channel_map)),),
-        placements=2,
-        cycles=2,
-    )
+    simulator = serve(model_for(procedure))
+    setup = setup_of(procedure, simulator)
     zeroes = walk_zeros(simulator, setup, gauges_for(setup), tmp_path, moves=False)
-    assert_zeros_of_several_readings(zeroes, channels, zeros)
+    assert_zeros_of_several_readings(zeroes, setup.procedure.channels, zeros)
 
 
 def test_a_zero_by_data_presses_is_the_mean_of_three(tmp_path: Path, serve, gauges_for) -> None:
     # A push gauge the operator presses DATA on: the simulator presses 20 times a second.
     simulator = serve(model_for("repeatability"), "uwave", push_rate=20.0)
-    catalog = discover_procedures(use_env=False)
-    setup = SessionSetup(
-        procedure=catalog.get("repeatability"),
-        robot="KSC-7",
-        operator="tester",
-        ports=(PortSetup(simulator.url, "uwave", dict(simulator.channel_map)),),
-        trigger="push",
-        cycles=2,
-    )
+    setup = setup_of("repeatability", simulator, "push")
     zeroes = walk_zeros(simulator, setup, gauges_for(setup), tmp_path, moves=False)
     assert_zeros_of_several_readings(zeroes, "xyz", 1)
     assert all(entry["n"] >= 3 for entry in zeroes[0]["channels"].values())
@@ -171,14 +166,6 @@ def test_a_zero_under_arrival_waits_for_the_moving_robot_at_rest(
 ) -> None:
     motion = CycleMotion(1.5, -0.375, 0.002)
     simulator = serve(model_for("repeatability"), motion=motion)
-    catalog = discover_procedures(use_env=False)
-    setup = SessionSetup(
-        procedure=catalog.get("repeatability"),
-        robot="KSC-7",
-        operator="tester",
-        ports=(PortSetup(simulator.url, "mitutoyo", dict(simulator.channel_map)),),
-        trigger="arrival",
-        cycles=2,
-    )
+    setup = setup_of("repeatability", simulator, "arrival")
     zeroes = walk_zeros(simulator, setup, gauges_for(setup), tmp_path, moves=True)
     assert_zeros_of_several_readings(zeroes, "xyz", 1)
