@@ -536,6 +536,18 @@ def show_joint(simulator) -> None:
     simulator.on_sent = on_sent
 
 
+def robot_line(simulator) -> str:
+    """How the simulated robot moves, for the start-up line on stderr."""
+    if simulator.motion is not None:
+        return f"; the robot leaves the fixture and returns every {simulator.motion.period:g} s"
+    if simulator.return_gap:
+        return (
+            f"; the robot moves to its next rest when the station pauses "
+            f"{simulator.return_gap:g} s (pace capture with --every above it)"
+        )
+    return ""
+
+
 def run(args: argparse.Namespace) -> int:
     """Print the URL, serve until SIGINT/SIGTERM."""
     simulator = build_simulator(args)
@@ -574,15 +586,7 @@ def run(args: argparse.Namespace) -> int:
         print(url, flush=True)
         print(
             f"station: simulating {', '.join(simulator.model.channels)} "
-            f"({simulator.protocol.name}) on {url}"
-            + (
-                f"; the robot leaves the fixture and returns every {simulator.motion.period:g} s"
-                if simulator.motion is not None
-                else "; the robot stays at rest (--cycle-period moves it)"
-                if args.model != "bar"
-                else ""
-            )
-            + "; Ctrl-C stops",
+            f"({simulator.protocol.name}) on {url}" + robot_line(simulator) + "; Ctrl-C stops",
             file=sys.stderr,
             flush=True,
         )

@@ -95,6 +95,8 @@ def walk_zeros(simulator: Simulator, setup: SessionSetup, gauges, folder: Path, 
                     {f.name: ANSWERS.get(f.name, "12.5") for f in state.action.fields if f.required}
                 )
             elif kind == "zero":
+                if setup.trigger == "push":
+                    assert "Press DATA 3 times, the robot still" in state.action.prompt
                 try:
                     runner.zero(timeout=10.0)
                 except GaugesMoving:
