@@ -32,10 +32,8 @@ others):
                (printed on stderr as "placement P: the pendant reads X=...
                Y=... Z=... in" when the robot gets there); the indicators at
                the first fixture read the return's error: --scale per unit
-               moved, --rotation (radians) about x, y, z, --noise. A protocol
-               without a zero command is zeroed in software, which reads one
-               set at home per placement; the simulated robot follows that
-               order (one home reading, then the return).
+               moved, --rotation (radians) about x, y, z, --noise. Each
+               placement is a rest at home (the zero), then the return.
   bar          linearity (report 2.9): indicators h, v and the linear scale s
                in inches. The robot shuttles A-B-A... along the bar (--length,
                --points per stroke, --dwell readings at each end); h sees the
@@ -43,8 +41,9 @@ others):
                wobble (--wobble, --wobble-v, --period). The indicators and the
                scale's counter send every set by themselves at --push-rate sets
                per second (default 200, as a counter's continuous output does):
-               capture with --trigger push. The robot advances one point per
-               set sent.
+               capture with --trigger push. The robot stands still at A for
+               --hold seconds (default 8) from the first frame it sends, where
+               the station zeroes, then advances one point per set sent.
   joints       per-joint troubleshooting (report 1.2, 2.8): x, y, z in inches
                at the fixture of a 3-joint arm (base, shoulder, elbow), each
                joint moved alone for --cycles-per-joint returns in turn (joint
@@ -53,25 +52,38 @@ others):
                J with --joint-fault backlash|noise|servo|encoder of
                --fault-size radians; the healthy joints repeat to 5e-6 rad.
                Printed on stderr as "joint J: ..." when the next joint's turn
-               comes, with its lever arm. A protocol without a zero command is
-               zeroed in software, which reads one set at the taught position
-               before each joint's returns; the simulated arm follows that.
+               comes, with its lever arm. Each joint's turn is a rest at the
+               taught position (the zero), then its returns.
   gauge-bench  the gauge check (Type-1 study): one indicator x in inches over
                a surface plate (zeroing reads the plate), a gauge block of
                --reference size re-seated for every reading, read with the
-               indicator's --bias and --noise (default 0.00003). A software
-               zero (no zero command) reads the plate once first.
+               indicator's --bias and --noise (default 0.00003). The first
+               rest is the plate (the zero), every later one a seating.
 
---cycle-period S makes the fixture model's robot leave the fixture and come
-back every S seconds, as a playback loop does: at rest (the model's bias,
-noise, drift and backlash for that cycle), then the indicators run out to
-their free travel (--free-travel, default -3/8 in or -9.525 mm) while the
-robot is away, then it returns with a short overshoot (--overshoot, default
-20 resolutions) and settles. The c-th rest position is the model's c-th value;
-a reading shows where the robot is when it is sent. --hunt CH=V makes an axis
-hunt by +-V at rest on every --hunt-every N-th return instead of settling
-(a return the station must report, not record).
+The models follow the robot's state, not the readings: at each rest every
+reading shows the same rest position plus the indicators' own noise
+(--gauge-noise, in resolutions), however often the station reads it. Without
+--cycle-period the robot moves to its next rest whenever the station has not
+polled it for --return-gap seconds (1), as a technician moves the robot
+while the station waits: pace `station capture --trigger poll` with --every
+above the gap, and the readings of one zero stay at one rest. The next rest
+is the next return at one fixture; with two-fixture, the placement's return
+after its home, then the next home; with joints, the next return or the next
+joint's taught position; with gauge-bench, the plate and then each seating
+of the block. --cycle-period S makes the fixture model's robot leave the
+fixture and come back every S seconds, as a playback loop does: at rest (the
+model's bias, noise, drift and backlash for that cycle), then the indicators
+run out to their free travel (--free-travel, default -3/8 in or -9.525 mm)
+while the robot is away, then it returns with a short overshoot
+(--overshoot, default 20 resolutions) and settles. The c-th rest position is
+the model's c-th value; a reading shows where the robot is when it is sent.
+--hunt CH=V makes an axis hunt by +-V at rest on every --hunt-every N-th
+return instead of settling (a return the station must report, not record).
 """
+
+
+BAR_HOLD = 8.0
+"""Seconds the bar model's robot stands at A (from the first reading) before it shuttles."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -159,6 +171,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     gauge.add_argument("--unit", default="mm", choices=("mm", "in"), help="unit (mm)")
     gauge.add_argument("--range", default="-12.5,12.5", metavar="LOW,HIGH", help="gauge range")
+    gauge.add_argument(
+        "--gauge-noise",
+        default="0.3",
+        metavar="R",
+        help="the indicators' own reading noise (sigma), in resolutions (0.3): readings at "
+        "rest scatter by it",
+    )
     motion = parser.add_argument_group("motion (fixture model)")
     motion.add_argument(
         "--cycle-period",
@@ -171,6 +190,16 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     motion.add_argument(
         "--overshoot", metavar="V", help="how far past its rest position the robot returns"
+    )
+    motion.add_argument(
+        "--return-gap",
+        default="1",
+        metavar="S",
+        help="without --cycle-period: the robot moves to its next rest whenever the station "
+        "has not polled for S seconds (1; 0 = never), so pace polls with --every above S",
+    )
+    motion.add_argument(
+        "--hold", metavar="S", help="bar: seconds the robot stands at A before shuttling (8)"
     )
     motion.add_argument(
         "--hunt", default="0", metavar="V", help="amplitude of an axis that hunts at rest (0)"
@@ -252,32 +281,28 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
     if args.model == "fixture":
         return None
     resolution = bounded_number(args.resolution, "--resolution", 1e-6, 1.0)
+    gauge_noise = gauge_noise_of(args, resolution)
     if args.model == "gauge-bench":
         from station.instruments.gauge_bench import GaugeBenchModel
 
         bias = per_channel(args.bias, "--bias", ["x"])["x"]
         noise = per_channel(args.noise, "--noise", ["x"])["x"]
         reference = _float(args.reference, "--reference")
-        # The station reads one set to check the frames before a session, then a software
-        # zero reads one set on the plate; a device zero reads none there.
-        plate_readings = 0 if protocol.zero_command(protocol.channels[0]) else 2
         return GaugeBenchModel(
             reference,
             bias=bias,
             noise=noise,
-            gauge=GaugeSpec(resolution, -0.5, 1.0, "in"),
-            plate_readings=plate_readings,
+            gauge=GaugeSpec(resolution, -0.5, 1.0, "in", gauge_noise),
         )
     if args.model == "joints":
         from station.instruments.joint_model import JointModel, faulty_arm
 
         cycles = positive_number(args.cycles_per_joint, "--cycles-per-joint", int)
-        # A software zero reads one set at the taught position before each joint's returns.
-        home_readings = 0 if protocol.zero_command(protocol.channels[0]) else 1
+        # Each joint's turn starts with a rest at the taught position, where the station zeroes.
         options = {
             "cycles": cycles,
-            "gauge": GaugeSpec(resolution, -0.5, 0.5, "in"),
-            "home_readings": home_readings,
+            "gauge": GaugeSpec(resolution, -0.5, 0.5, "in", gauge_noise),
+            "home_readings": 1,
         }
         try:
             joint = int(args.faulty_joint)
@@ -295,20 +320,15 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
         if len(set(noise.values())) != 1:
             raise StationError("--noise: the two-fixture model takes one noise sigma for x, y, z.")
         reach_min, reach_max = _pair(args.reach, "--reach")
-        # A software zero reads one set at home per placement; a device zero reads none.
-        home_readings = 0 if protocol.zero_command(protocol.channels[0]) else 1
         return TwoFixtureModel(
             scale=tuple(scale[a] for a in axes),
             rotation=tuple(rotation[a] for a in axes),
             noise=noise["x"],
             reach_min=reach_min,
             reach_max=reach_max,
-            home_readings=home_readings,
             preload=_float(args.preload, "--preload"),
-            gauge=GaugeSpec(resolution, -0.5, 0.5, "in"),
+            gauge=GaugeSpec(resolution, -0.5, 0.5, "in", gauge_noise),
             seed=seed,
-            # The station reads one set to check the frames before the session starts.
-            lead_readings=1,
         )
     noise = per_channel(args.noise, "--noise", ["h", "v", "s"])
     try:
@@ -325,8 +345,13 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
         wobble_v=_float(args.wobble_v, "--wobble-v"),
         period=_float(args.period, "--period"),
         noise=noise["h"],
-        indicator=GaugeSpec(resolution, -0.5, 0.5, "in"),
+        indicator=GaugeSpec(resolution, -0.5, 0.5, "in", gauge_noise),
     )
+
+
+def gauge_noise_of(args: argparse.Namespace, resolution: float) -> float:
+    """The indicators' own noise (σ) in their unit, from ``--gauge-noise`` in resolutions."""
+    return _float(args.gauge_noise, "--gauge-noise", 0.0, 100.0) * resolution
 
 
 def build_simulator(args: argparse.Namespace):
@@ -376,7 +401,7 @@ def build_simulator(args: argparse.Namespace):
         ) from None
     resolution = bounded_number(args.resolution, "--resolution", 1e-6, 1.0)
     model = _procedure_model(args, protocol, seed) or FixtureModel(
-        axes, GaugeSpec(resolution, low, high, args.unit)
+        axes, GaugeSpec(resolution, low, high, args.unit, gauge_noise_of(args, resolution))
     )
     faults = Faults(
         garbage_rate=_rate(args.garbage_rate, "--garbage-rate"),
@@ -402,6 +427,14 @@ def build_simulator(args: argparse.Namespace):
             push_rate=push_rate,
             motion=build_motion(args, model, channels),
         )
+        if simulator.motion is None and args.model != "bar":
+            # The operator moves the robot while the station waits between its steps.
+            simulator.return_gap = _float(args.return_gap, "--return-gap", 0.0, 1e6) or None
+        if args.model == "bar":
+            # The robot stands still at A while the station zeroes, then shuttles.
+            simulator.leave_first_rest_after = (
+                _float(args.hold, "--hold", 0.0, 1e6) if args.hold is not None else BAR_HOLD
+            )
         # Every channel's frame must be writable at this resolution and range before serving.
         for device, channel in simulator.channel_map.items():
             protocol.wire_channel(device)
@@ -438,8 +471,8 @@ def build_motion(args: argparse.Namespace, model, channels: list[str]):
         return None
     if args.model != "fixture":
         raise StationError(
-            f"--cycle-period moves the fixture model's robot; the {args.model} model has its "
-            "own motion."
+            f"--cycle-period moves the fixture model's robot; the {args.model} model's robot "
+            "moves where its procedure's steps take it (see --return-gap)."
         )
     period = positive_number(args.cycle_period, "--cycle-period")
     gauge = model.gauge(channels[0])
@@ -462,13 +495,10 @@ def show_pendant(simulator) -> None:
     """Print the teach pendant's display on stderr whenever the robot reaches another
     placement (two-fixture model): the operator of a headless capture types it in."""
     model = simulator.model
-    channels = tuple(simulator.channel_map.values())
     shown = [0]
 
     def on_sent(channel: str, k: int) -> None:
-        # The placement changes once every channel's reading of the last one is out.
-        sent = min(len(simulator.sent[c]) for c in channels)
-        number = model.current_placement(sent)
+        number = model.current_placement(_rest_of_last(simulator, channel))
         if number != shown[0]:
             shown[0] = number
             text = model.placement_of(number).pendant_text()
@@ -478,17 +508,21 @@ def show_pendant(simulator) -> None:
     simulator.on_sent = on_sent
 
 
+def _rest_of_last(simulator, channel: str) -> int:
+    """The robot's rest when ``channel``'s last frame was sent (its first rest before any)."""
+    sent = simulator.sent.get(channel) if channel else None
+    return int(sent[-1].cycle or 0) if sent else 0
+
+
 def show_joint(simulator) -> None:
     """Print on stderr which joint to move when its turn comes (joints model), with its lever
     arm (the distance from its axis to the cube, for the analysis)."""
     model = simulator.model
-    channels = tuple(simulator.channel_map.values())
     levers = model.lever_arms()
     shown = [0]
 
     def on_sent(channel: str, k: int) -> None:
-        sent = min(len(simulator.sent[c]) for c in channels)
-        number = model.current_joint(sent)
+        number = model.current_joint(_rest_of_last(simulator, channel))
         if number != shown[0]:
             shown[0] = number
             print(
@@ -500,6 +534,18 @@ def show_joint(simulator) -> None:
 
     on_sent("", 0)
     simulator.on_sent = on_sent
+
+
+def robot_line(simulator) -> str:
+    """How the simulated robot moves, for the start-up line on stderr."""
+    if simulator.motion is not None:
+        return f"; the robot leaves the fixture and returns every {simulator.motion.period:g} s"
+    if simulator.return_gap:
+        return (
+            f"; the robot moves to its next rest when the station pauses "
+            f"{simulator.return_gap:g} s (pace capture with --every above it)"
+        )
+    return ""
 
 
 def run(args: argparse.Namespace) -> int:
@@ -540,13 +586,7 @@ def run(args: argparse.Namespace) -> int:
         print(url, flush=True)
         print(
             f"station: simulating {', '.join(simulator.model.channels)} "
-            f"({simulator.protocol.name}) on {url}"
-            + (
-                f"; the robot leaves the fixture and returns every {simulator.motion.period:g} s"
-                if simulator.motion is not None
-                else ""
-            )
-            + "; Ctrl-C stops",
+            f"({simulator.protocol.name}) on {url}" + robot_line(simulator) + "; Ctrl-C stops",
             file=sys.stderr,
             flush=True,
         )

@@ -1,11 +1,13 @@
 """A simulated gauge bench for the gauge check (Type-1 study): one indicator over a surface plate,
 a gauge block of known size re-seated under it for every reading.
 
-A device zero sets the indicator's zero on the plate (:meth:`GaugeBenchModel.zero_reference`);
-a software zero reads one set on the plate, so a run zeroed in software wants
-``plate_readings=1``: its first reading is the plate (0 plus noise). Every later reading is the
-block's size ``reference`` plus the indicator's ``bias`` and its repeatability ``noise`` (σ),
-at the indicator's resolution. A gauge with a bias fails Cgk; a noisy one fails Cg.
+The model follows the bench's state, not the readings: the first rest (the simulator's robot
+state 0) is the spindle on the surface plate, where the station zeroes (a device zero sets the
+indicator's zero on the plate, :meth:`GaugeBenchModel.zero_reference`; a software zero reads the
+plate as many times as it likes); every later rest is the block re-seated under the spindle:
+its size ``reference`` plus the indicator's ``bias`` and its repeatability ``noise`` (σ, drawn
+per seating), at the indicator's resolution. A gauge with a bias fails Cgk; a noisy one fails
+Cg.
 """
 
 from __future__ import annotations
@@ -32,7 +34,6 @@ class GaugeBenchModel(RobotModel):
         bias: float = 0.0,
         noise: float = 0.00003,
         gauge: GaugeSpec = BENCH_INDICATOR,
-        plate_readings: int = 0,
     ) -> None:
         if noise < 0:
             raise StationError(f"the gauge's noise must not be negative, not {noise}.")
@@ -43,20 +44,22 @@ class GaugeBenchModel(RobotModel):
             )
         self.reference, self.bias, self.noise = float(reference), float(bias), float(noise)
         self._gauge = gauge
-        if plate_readings < 0:
-            raise StationError("the readings on the plate must not be negative.")
-        self.plate_readings = int(plate_readings)
 
     def gauge(self, channel: str) -> GaugeSpec:
         """The indicator."""
         return self._gauge
 
-    def value(self, channel: str, k: int, seed: int) -> float:
-        """The k-th reading: the plate for the first ``plate_readings``, then the block."""
-        noise = random.Random(f"{seed}/bench/{k}").gauss(0.0, 1.0)
-        size = 0.0 if k < self.plate_readings else self.reference + self.bias
-        return self._gauge.show(size + self.noise * noise)
+    def rest_position(self, channel: str, rest: int, seed: int) -> float:
+        """The plate at rest 0, then the block as seated the ``rest``-th time."""
+        if rest <= 0:
+            return 0.0
+        noise = random.Random(f"{seed}/bench/{rest}").gauss(0.0, 1.0)
+        return self.reference + self.bias + self.noise * noise
 
-    def zero_reference(self, channel: str, k_next: int, seed: int) -> float:
+    def value(self, channel: str, rest: int, seed: int) -> float:
+        """The ``rest``-th rest as the indicator shows it: the plate, then the block."""
+        return self._gauge.show(self.rest_position(channel, rest, seed))
+
+    def zero_reference(self, channel: str, rest: int, seed: int) -> float:
         """Zeroing on the surface plate: the indicator's zero is the plate."""
         return 0.0

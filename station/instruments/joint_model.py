@@ -18,13 +18,14 @@ full lost motion
 between the two approach directions (radians), and ``offset`` a constant angular error of the
 return (an encoder whose zero slipped). Each indicator adds its own reading noise ``gauge_noise``.
 
-Zeroing: a device zero (a protocol with a zero command) sets the indicators' zero at the taught
-position without a reading (:meth:`JointModel.zero_reference`); a software zero reads one set
-there, so a run zeroed in software wants ``home_readings=1``: each joint's block then starts with
-that reading at the taught position (no angular error), followed by its ``cycles`` returns.
+The model follows the arm's state (the simulator's robot rests, stepped as the arm leaves and
+comes back), not the readings: with ``home_readings=1`` each joint's block starts with a rest at
+the taught position (no angular error), where the station zeroes from as many readings as it
+likes (a device zero, :meth:`JointModel.zero_reference`, sets the indicators' zero there), then
+its ``cycles`` returns, one rest each.
 
-Determinism as :mod:`station.instruments.simulator`: the k-th reading depends only on the seed
-and k; the joint's angular error of reading k is drawn once for all three indicators.
+Determinism as :mod:`station.instruments.simulator`: the k-th rest depends only on the seed and
+k; the joint's angular error of rest k is drawn once for all three indicators.
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from station.errors import StationError
-from station.instruments.simulator import GaugeSpec, RobotModel, _skew_normal_unit
+from station.instruments.simulator import GaugeSpec, RobotModel, skew_normal_unit
 
 JOINTS = 3
 #: The fixture's indicators: 0.0001 in over ±0.5 in.
@@ -122,6 +123,16 @@ class JointModel(RobotModel):
         """Readings of each channel per joint: at the taught position, then the returns."""
         return self.home_readings + self.cycles
 
+    def rest_of(self, joint: int, returned: int = 0) -> int:
+        """The rest at the taught position before ``joint``'s returns (``returned`` 0), or of
+        its ``returned``-th return (1, 2, ...; needs ``home_readings`` 1)."""
+        if not 1 <= joint <= JOINTS or not 0 <= returned <= self.cycles:
+            raise StationError(
+                f"joint {joint} has a rest at the taught position and {self.cycles} returns, "
+                f"not return {returned}."
+            )
+        return (joint - 1) * self.readings_per_joint + returned + self.home_readings - 1
+
     def current_joint(self, k: int) -> int:
         """The joint (1-based) whose block the k-th reading belongs to."""
         if self.joint is not None:
@@ -143,7 +154,7 @@ class JointModel(RobotModel):
         direction = 1.0 if cycle % 2 == 0 else -1.0
         return (
             fault.offset
-            + fault.noise * _skew_normal_unit(fault.skew, z0, z1)
+            + fault.noise * skew_normal_unit(fault.skew, z0, z1)
             + direction * fault.backlash / 2.0
             + overshoot
         )
@@ -155,11 +166,15 @@ class JointModel(RobotModel):
         reading_noise = random.Random(f"{seed}/{index}/{k}").gauss(0.0, 1.0)
         return column[index] * self.angular_error(k, seed) + self.gauge_noise * reading_noise
 
+    def rest_position(self, channel: str, rest: int, seed: int) -> float:
+        """Where the indicator rests at the ``rest``-th rest, before quantisation."""
+        return self.true_value(channel, rest, seed)
+
     def value(self, channel: str, k: int, seed: int) -> float:
-        """The k-th displayed reading of ``channel``."""
+        """The k-th rest of ``channel`` as the gauge shows it."""
         return self._gauge.show(self.true_value(channel, k, seed))
 
-    def zero_reference(self, channel: str, k_next: int, seed: int) -> float:
+    def zero_reference(self, channel: str, rest: int, seed: int) -> float:
         """A device zero with the cube at the taught position, before the joint moves: the
         indicators' zero is that position."""
         return 0.0

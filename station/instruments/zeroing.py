@@ -25,7 +25,8 @@ from station.instruments.protocols.common import decimals_for
 ZeroMethod = Literal["device", "software"]
 
 DEFAULT_ZERO_READINGS = 10
-"""Readings per channel a zero step takes when the procedure does not say."""
+"""Readings per channel :func:`zero_from_readings` wants unless told (a zero step without
+``readings`` asks for 5, or 3 DATA presses: ``station.run.steps.zero``)."""
 DEFAULT_ZERO_SETTLE = 1.0
 """Seconds the readings of a zero are spread over when the procedure does not say."""
 DEFAULT_ZERO_STILL = 3.0

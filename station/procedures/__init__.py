@@ -55,7 +55,7 @@ Keys per step kind, beyond ``id``, ``kind``, ``title`` and ``text``:
 
 - ``input``: ``fields = [{ name, label, type = "number"|"text", unit, required }]``
 - ``zero``: ``channels`` (default: all), ``readings`` (per channel, 2 or more: the zero is
-  their mean; without it the gauge's zero command, else one reading set), ``settle`` (seconds
+  their mean; default 5, or 3 DATA presses with the push trigger), ``settle`` (seconds
   the readings are spread over; default 1.0) and ``still`` (resolutions the readings may spread
   before a gauge counts as moving and the zero is refused; default 3)
 - ``capture``: ``channels`` (default: all the procedure's channels)

@@ -356,9 +356,8 @@ def _parse_step(context: _StepContext, raw: Any, number: str, *, nested: bool = 
             raise check.fail(
                 where, f"'readings' must be 2 or more (a zero is a mean), not {readings}"
             )
-        # Without ``readings`` the step zeroes as before this window existed: the gauge's own
-        # zero command, else one reading set (a simulated set-up that counts its readings at
-        # home relies on it); ``settle`` and ``still`` then keep their defaults for the record.
+        # Without ``readings`` the engine chooses by the session's trigger (several readings
+        # always: one reading is no zero); ``settle`` and ``still`` keep their defaults.
         values["readings"] = readings
         for key, default in (("settle", DEFAULT_ZERO_SETTLE), ("still", DEFAULT_ZERO_STILL)):
             number = check.number(raw, key, where, required=False)

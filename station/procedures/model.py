@@ -67,8 +67,8 @@ class Step:
     options: Mapping[str, Any] = field(default_factory=dict)
     """The values of the keys a registered step kind declares as its own (``schema.keys``)."""
     readings: int | None = None
-    """A ``zero`` step: readings per channel the zero is the mean of (None: the gauge's zero
-    command, else one reading set; always None for other kinds)."""
+    """A ``zero`` step: readings per channel the zero is the mean of (None: the engine's default
+    for the session's trigger, always several; always None for other kinds)."""
     settle: float | None = None
     """A ``zero`` step: seconds its readings are spread over."""
     still: float | None = None

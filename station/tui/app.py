@@ -36,6 +36,7 @@ from textual.screen import ModalScreen, Screen
 from station.errors import StationError
 from station.plain import plain
 from station.tui.autopilot import run_autopilot
+from station.tui.instruments import running_fixture
 from station.tui.messages import RunnerChanged
 from station.tui.remedies import explained
 from station.tui.screens.dialogs import ConfirmScreen, HelpScreen, QuitQuestion, screen_keys
@@ -328,7 +329,7 @@ class StationApp(App[int]):
     def _find_demo_fixture(self, setup: SessionSetup) -> None:
         lab = self.config.demo_lab
         urls = [port.url for port in setup.ports]
-        found = [lab.by_url(url) for url in urls] if lab is not None else []
+        found = [lab.by_url(url) if lab is not None else running_fixture(url) for url in urls]
         self.demo_fixture = next((f for f in found if f is not None), None)
 
     def start_session(self, setup: SessionSetup) -> None:
@@ -447,7 +448,7 @@ class StationApp(App[int]):
         fixture = self.demo_fixture
         if fixture is not None:
             # The simulated robot goes where the procedure says (its pendant follows).
-            fixture.at_placement(notice.state.placement)
+            fixture.follow(notice.state)
         event_type = str((notice.event or {}).get("type", "")) if notice.event else ""
         sink = self.sample_sink
         if sink is not None and event_type == "samples":

@@ -23,6 +23,8 @@ TEST_CAPTURES = 5
 REST_START_SLACK = 0.05
 """A zero may begin this part of a period after the simulated robot came to rest (its dwell
 is 0.35 of the period; the zero needs its settle time of stillness within it)."""
+DEMO_GAUGE_NOISE = 0.3
+"""The demo indicators' own reading noise, in resolutions (σ): a robot at rest looks at rest."""
 
 DEMO_PROCEDURES = {
     "repeatability": "three dial indicators in one fixture",
@@ -52,11 +54,34 @@ class DemoFixture:
             return None
         return placement_of(placement)
 
-    def at_placement(self, placement: int | None) -> None:
-        """Tell the two-fixture model where the robot is (the pendant shown then follows)."""
-        model = self.simulator.model
-        if placement is not None and hasattr(model, "placement_of"):
-            model.placement = placement
+    def follow(self, state: Any) -> None:
+        """Put the still simulated robot where the procedure's state says the operator has
+        brought it (a moving robot follows its own clock): for two fixtures, home at the
+        placement's first fixture until its return is to be captured; for one fixture, the
+        taught position (rest 0) for the zero, then a new return for every cycle; on the bar,
+        still at its end for the zeros, shuttling for the strokes. However many
+        sets the station reads at one of these rests, they all read that rest."""
+        simulator = self.simulator
+        if simulator.motion is not None:
+            return
+        model = simulator.model
+        capturing = state.action.kind == "capture"
+        if model.moves_per_set:
+            # The bar's robot stands at its end for the zeros and shuttles for the strokes.
+            rest = 1 if state.action.kind == "stream" else 0
+        elif hasattr(model, "rest_of"):
+            # Blocks of a rest where the station zeroes, then returns (two fixtures: one).
+            done = state.progress.done if state.progress is not None else 0
+            returned = min(done + 1, getattr(model, "cycles", 1)) if capturing else 0
+            rest = model.rest_of(state.placement or 1, returned)
+        elif isinstance(state.next_cycle, int) and capturing:
+            rest = state.next_cycle
+        elif state.action.kind in ("zero", "confirm", "input"):
+            rest = 0
+        else:
+            return
+        if rest != simulator.rest:
+            simulator.move_to_rest(rest)
 
     def wait_at_rest(self) -> None:
         """Block until the simulated robot has just come to rest at the fixture, as a
@@ -76,7 +101,25 @@ class DemoFixture:
 
     def stop(self) -> None:
         """Close the pseudo-terminal and stop the simulator's thread."""
+        _RUNNING.pop(self.url, None)
         self.simulator.stop()
+
+
+_RUNNING: dict[str, DemoFixture] = {}
+"""The simulated set-ups started in this process, by URL: a session on one of them moves its
+robot where the steps say (:meth:`DemoFixture.follow`)."""
+
+
+def track(fixture: DemoFixture) -> DemoFixture:
+    """Follow ``fixture`` (a simulated set-up started in this process) in the sessions that
+    use its URL, until it stops."""
+    _RUNNING[fixture.url] = fixture
+    return fixture
+
+
+def running_fixture(url: str) -> DemoFixture | None:
+    """The simulated set-up started in this process that serves ``url``, if any."""
+    return _RUNNING.get(url)
 
 
 def start_demo_fixture(
@@ -118,12 +161,15 @@ def start_demo_fixture(
     )
 
     protocol = get_protocol(DEMO_PROTOCOL)
-    gauge = GaugeSpec(resolution=resolution, low=-0.5, high=0.5, unit=unit)
+    # The indicators' own noise: readings at rest scatter by about a third of a resolution.
+    gauge = GaugeSpec(
+        resolution=resolution, low=-0.5, high=0.5, unit=unit, noise=DEMO_GAUGE_NOISE * resolution
+    )
     channel_map, trigger, push_rate = DEMO_CHANNEL_MAP, "poll", 0.0
     if procedure == "relative_accuracy":
-        # Mitutoyo has no zero command: the station zeroes in software, reading one set at
-        # home per placement, so the preload really has to be zeroed out.
-        model: Any = TwoFixtureModel(home_readings=1, preload=0.05, gauge=gauge, seed=seed)
+        # Mitutoyo has no zero command: the station zeroes in software from readings at home,
+        # so the preload really has to be zeroed out.
+        model: Any = TwoFixtureModel(preload=0.05, gauge=gauge, seed=seed)
         description = "two simulated fixtures and a teach pendant (seeded)"
     elif procedure == "linearity":
         model = BarModel(points=stroke_points, indicator=gauge)
@@ -148,7 +194,7 @@ def start_demo_fixture(
         protocol, model, seed=seed, channel_map=channel_map, push_rate=push_rate, motion=motion
     )
     url = simulator.start_pty(link=link)
-    return DemoFixture(
+    fixture = DemoFixture(
         url=url,
         protocol=DEMO_PROTOCOL,
         channel_map=dict(channel_map),
@@ -157,6 +203,7 @@ def start_demo_fixture(
         trigger=trigger,
         description=description,
     )
+    return track(fixture)
 
 
 class DemoLab:

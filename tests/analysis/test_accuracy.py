@@ -16,9 +16,14 @@ CONFIG = AnalysisConfig(resolution=0.0001, unit="in", default_limits=SpecLimits(
 
 def simulated_run(model: TwoFixtureModel, placements: int, seed: int = 0):
     """What the first fixture's indicators read, placement by placement (no runner)."""
-    count = placements * model.captures
-    numbers = [model.current_placement(k) for k in range(count)]
-    errors = {axis: [model.value(axis, k, seed) for k in range(count)] for axis in "xyz"}
+    # The robot's rests after each return (rest 0 of each placement is home, the zero).
+    rests = [
+        model.rest_of(number, c)
+        for number in range(1, placements + 1)
+        for c in range(1, model.captures + 1)
+    ]
+    numbers = [model.current_placement(r) for r in rests]
+    errors = {axis: [model.value(axis, r, seed) for r in rests] for axis in "xyz"}
     pendant = {p: model.placement_of(p).pendant for p in range(1, placements + 1)}
     return numbers, errors, pendant
 

@@ -46,11 +46,13 @@ def linearity_csv(tmp_path_factory) -> Path:
 def accuracy_csv(tmp_path_factory) -> Path:
     model = TwoFixtureModel(captures=2, seed=8)
     rows = ["placement,x,y,z,px,py,pz"]
-    for k in range(10):
-        placement = model.placement_of(model.current_placement(k))
-        errors = ",".join(str(model.value(axis, k, 1)) for axis in "xyz")
-        pendant = ",".join(str(c) for c in placement.pendant)
-        rows.append(f"{placement.number},{errors},{pendant}")
+    # Two returns per placement (rests 1 and 2 of each block of three: home, return, return).
+    for number in range(1, 6):
+        for rest in (model.rest_of(number, 1), model.rest_of(number, 2)):
+            placement = model.placement_of(model.current_placement(rest))
+            errors = ",".join(str(model.value(axis, rest, 1)) for axis in "xyz")
+            pendant = ",".join(str(c) for c in placement.pendant)
+            rows.append(f"{placement.number},{errors},{pendant}")
     path = tmp_path_factory.mktemp("accuracy") / "fixtures.csv"
     path.write_text("\n".join(rows) + "\n")
     return path

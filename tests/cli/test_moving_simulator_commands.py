@@ -49,7 +49,7 @@ def test_read_prints_one_set_per_round_trip_and_what_the_frames_say() -> None:
     [
         (["--free-travel", "-1"], "--free-travel needs --cycle-period"),
         (["--cycle-period", "0"], "--cycle-period"),
-        (["--cycle-period", "1", "--model", "bar"], "the bar model has its own motion"),
+        (["--cycle-period", "1", "--model", "bar"], "moves where its procedure's steps take it"),
         (["--cycle-period", "1", "--hunt-every", "0"], "--hunt-every"),
     ],
 )

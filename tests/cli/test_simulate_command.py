@@ -66,7 +66,10 @@ def test_url_first_then_the_seeded_values_then_a_clean_exit(where: str, sig: int
     )
     protocol = get_protocol("idh")
     values = [protocol.parse(frame).value for frame in frames]
-    assert values == pytest.approx([model.value("x", k, 42) for k in range(4)], abs=1e-9)
+    # The robot stays at its first rest: its readings scatter by the indicator's own noise
+    # (0.3 of a resolution by default) about that rest position.
+    rest = model.value("x", 0, 42)
+    assert all(abs(v - rest) <= 3 * 0.0005 + 1e-9 for v in values), (values, rest)
     assert code == 0
     assert "Traceback" not in err
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import subprocess
 
-import pytest
 from helpers import STATION, start_simulator, stop_simulator
 
 from station.instruments.joint_model import faulty_arm
@@ -29,23 +28,29 @@ def test_joints_model_serves_the_faulty_arm_and_names_the_joint_to_move() -> Non
         "4",
         "--seed",
         "7",
+        "--gauge-noise",
+        "0",
     )
     try:
         protocol = get_protocol("idh")
         port = open_port(url, protocol.settings, timeout=2.0)
         try:
             values = []
-            for _ in range(4):
+            for _ in range(3):  # the taught position, however often it is read
                 port.write(protocol.request("1"))
                 values.append(protocol.parse(port.read_until(protocol.terminator).strip()).value)
         finally:
             port.close()
     finally:
         err = stop_simulator(process)
-    arm = faulty_arm(1, "backlash", size=8e-5, cycles=4, gauge=GaugeSpec(0.0001, -0.5, 0.5, "in"))
-    assert values == pytest.approx([arm.value("x", k, 7) for k in range(4)], abs=1e-9)
-    # Backlash of 8e-5 rad, x seeing 17.9 in per radian of joint 1: x alternates by 0.0014 in.
-    assert abs((values[0] + values[2]) - (values[1] + values[3])) / 2 > 0.001
+    inch = GaugeSpec(0.0001, -0.5, 0.5, "in")
+    arm = faulty_arm(1, "backlash", size=8e-5, cycles=4, home_readings=1, gauge=inch)
+    # The still arm stands at the taught position (its first rest): no angular error there.
+    assert values == [0.0, 0.0, 0.0]
+    # Its returns, rest by rest (what the simulator shows as the arm leaves and comes back):
+    # backlash of 8e-5 rad, x seeing 17.9 in per radian of joint 1, alternates by 0.0014 in.
+    returns = [arm.value("x", k, 7) for k in range(1, 5)]
+    assert abs((returns[0] + returns[2]) - (returns[1] + returns[3])) / 2 > 0.001
     assert "joint 1: move only joint 1 away and back (lever arm 31.177 in)" in err
     assert process.returncode == 0
 

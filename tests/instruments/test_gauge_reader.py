@@ -11,6 +11,7 @@ from waiting import wait_until
 
 from station.errors import StationError
 from station.instruments.gauge import GaugeSet, PortSpec
+from station.instruments.motion import CycleMotion
 from station.instruments.protocols import get_protocol, protocol_names
 from station.instruments.reader import GaugeReader
 from station.instruments.simulator import (
@@ -93,11 +94,13 @@ def _push_capture(gauges: GaugeSet, sim: Simulator):
 
 @pytest.mark.parametrize("name", ["mitutoyo", "uwave"])
 def test_stable_trigger_waits_for_a_settled_set(name: str) -> None:
-    # A gauge that is still settling: big warm-up drift with a short time constant, no noise.
-    model = fixture_model(
-        ["x", "y"], axis=AxisModel(noise=0.0, drift=0.2, drift_tau=3.0), gauge=GaugeSpec(0.001)
+    # The robot leaves the fixture and comes back with an overshoot and a settling swing; the
+    # stable trigger asked while it moves takes the next set that has settled at rest.
+    model = fixture_model(["x", "y"], axis=AxisModel(noise=0.01), gauge=GaugeSpec(0.001))
+    motion = CycleMotion(1.0, -5.0, 0.05, dwell=0.35, depart=0.1, away=0.05, approach=0.2)
+    sim = Simulator(
+        get_protocol(name), model, seed=1, push_rate=0 if name == "mitutoyo" else 50, motion=motion
     )
-    sim = Simulator(get_protocol(name), model, seed=1, push_rate=0 if name == "mitutoyo" else 50)
     url = sim.start_pty()
     gauges = GaugeSet(
         [PortSpec(url, get_protocol(name), dict(sim.channel_map))],
@@ -111,18 +114,19 @@ def test_stable_trigger_waits_for_a_settled_set(name: str) -> None:
     try:
         gauges.start()
         assert gauges.wait_connected(3.0)
+        # Ask once the robot has left (the set at rest before it does not count).
+        while motion.stage(time.monotonic() - sim.motion_t0)[1] == "at rest":
+            time.sleep(0.005)
         result = gauges.capture(5.0)
     finally:
         gauges.stop()
         sim.stop()
     assert result.complete, result.message
     for channel in ("x", "y"):
-        sent = sim.sent_values(channel)
         taken = result.readings[channel].value
-        # Settled: within 2 resolutions of where the drift ends, and no longer moving.
-        assert abs(taken - 0.2) <= 0.002 + 1e-9
-        assert taken in sent
-        assert sent.index(taken) >= 10  # the early, drifting readings were not taken
+        # Settled: within 2 resolutions of where the robot came to rest, not mid-travel.
+        assert any(abs(taken - sim.rest_value(channel, c)) <= 0.002 + 1e-9 for c in (1, 2))
+        assert taken in sim.sent_values(channel)
 
 
 def test_stale_frames_from_before_the_trigger_are_never_taken() -> None:

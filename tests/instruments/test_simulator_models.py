@@ -7,6 +7,7 @@ import math
 import os
 import select
 import time
+import tty
 
 import numpy as np
 import pytest
@@ -85,6 +86,7 @@ def test_the_simulator_serves_the_bar_and_the_strokes_come_back():
     sim = Simulator(protocol, model, seed=7)
     path = sim.start_pty()
     fd = os.open(path, os.O_RDWR | os.O_NOCTTY)
+    sim.move_to_rest(1)  # the strokes: the robot shuttles, one point per set sent
     sets = 4 * model.readings_per_stroke + model.dwell
     try:
         for _ in range(0, sets, 22):
@@ -131,31 +133,103 @@ def test_the_error_grows_with_the_move_scale_and_rotation():
     assert ez == pytest.approx(-1e-5 * pz)
 
 
-def test_readings_follow_the_placement_index_or_the_set_placement():
+def test_readings_follow_the_robots_rest_home_then_each_return():
     model = TwoFixtureModel(noise=0.0, captures=2, seed=2)
-    assert [model.current_placement(k) for k in range(5)] == [1, 1, 2, 2, 3]
-    expected = model.gauge("x").show(model.systematic_error(2)[0])
-    assert model.value("x", 2, 0) == expected
-    model.placement = 4
-    assert model.value("x", 0, 0) == model.gauge("x").show(model.systematic_error(4)[0])
+    assert [model.current_placement(r) for r in range(7)] == [1, 1, 1, 2, 2, 2, 3]
+    assert [model.at_home(r) for r in range(4)] == [True, False, False, True]
+    assert model.rest_of(2) == 3 and model.rest_of(2, 1) == 4
+    error = model.gauge("x").show(model.systematic_error(2)[0])
+    assert model.value("x", model.rest_of(2, 1), 0) == error
+    assert model.value("x", model.rest_of(2), 0) == 0.0  # at home: no error, no preload
+    with pytest.raises(StationError):
+        model.rest_of(2, 3)
     with pytest.raises(StationError):
         TwoFixtureModel(captures=0)
 
 
-def test_the_simulator_serves_the_two_fixtures():
+def serve_two_fixtures(seed: int = 4):
     protocol = get_protocol("mitutoyo")
-    model = TwoFixtureModel(captures=1, seed=9)
-    sim = Simulator(protocol, model, seed=4)
+    model = TwoFixtureModel(captures=1, preload=0.05, noise=0.0002, seed=9)
+    sim = Simulator(protocol, model, seed=seed)
     path = sim.start_pty()
-    fd = os.open(path, os.O_RDWR | os.O_NOCTTY)
+    return protocol, model, sim, os.open(path, os.O_RDWR | os.O_NOCTTY)
+
+
+def by_channel(sim: Simulator, values: list[Value]) -> dict[str, list[float]]:
+    found: dict[str, list[float]] = {"x": [], "y": [], "z": []}
+    for value in values:
+        found[sim.channel_map[value.device_channel]].append(value.value)
+    return found
+
+
+def test_the_simulator_serves_the_two_fixtures_at_home_then_after_the_return():
+    protocol, model, sim, fd = serve_two_fixtures()
     try:
-        sim.push(5)
-        values = read_values(fd, protocol, 15)
+        sim.push(2)
+        home = by_channel(sim, read_values(fd, protocol, 6))
+        sim.robot_returns()
+        sim.push(1)
+        back = by_channel(sim, read_values(fd, protocol, 3))
     finally:
         os.close(fd)
         sim.stop()
-    by_channel = {"x": [], "y": [], "z": []}
-    for value in values:
-        by_channel[sim.channel_map[value.device_channel]].append(value.value)
-    for channel, got in by_channel.items():
-        assert got == [model.value(channel, k, 4) for k in range(5)]
+    for channel in ("x", "y", "z"):
+        assert home[channel] == [model.value(channel, 0, 4)] * 2
+        assert back[channel] == [model.value(channel, 1, 4)]
+        index = "xyz".index(channel)
+        error = model.systematic_error(1)[index]
+        preload = model.preload_of(1)[index]
+        assert abs(home[channel][0] - preload) < 0.001  # the preload and noise only
+        assert back[channel][0] - home[channel][0] == pytest.approx(error, abs=0.0015)
+
+
+def test_extra_reads_at_home_never_shift_which_fixture_is_read():
+    """The frames check and a zero of several readings read home as often as they like: the
+    capture after the return still reads the return, and the next placement's home its home."""
+    protocol, model, sim, fd = serve_two_fixtures()
+    try:
+        sim.push(3)  # the frames check
+        sim.push(5)  # a zero of five readings
+        home = by_channel(sim, read_values(fd, protocol, 24))
+        sim.move_to_rest(model.rest_of(1, 1))
+        sim.push(1)
+        back = by_channel(sim, read_values(fd, protocol, 3))
+        sim.move_to_rest(model.rest_of(2))
+        sim.push(7)  # more reads at the next home
+        next_home = by_channel(sim, read_values(fd, protocol, 21))
+    finally:
+        os.close(fd)
+        sim.stop()
+    for channel in ("x", "y", "z"):
+        assert set(home[channel]) == {model.value(channel, model.rest_of(1), 4)}
+        assert back[channel] == [model.value(channel, model.rest_of(1, 1), 4)]
+        assert set(next_home[channel]) == {model.value(channel, model.rest_of(2), 4)}
+
+
+def request_set(fd: int, protocol, sim: Simulator) -> dict[str, list[float]]:
+    """Poll every channel once, as the station does, and parse the answers."""
+    for request in dict.fromkeys(protocol.request(device) for device in sim.channel_map):
+        os.write(fd, request)
+    return by_channel(sim, read_values(fd, protocol, 3))
+
+
+def test_a_pause_in_the_polls_is_the_operator_moving_the_robot():
+    """``station simulate``'s still robot: polls close together (the frames check, a zero's
+    readings) read one rest; after a pause of ``return_gap`` the robot is at its next rest (the
+    placement's return, then the next placement's home)."""
+    protocol, model, sim, fd = serve_two_fixtures()
+    sim.return_gap = 0.3
+    try:
+        tty.setraw(fd)
+        home = [request_set(fd, protocol, sim) for _ in range(6)]  # frames check + a zero
+        time.sleep(0.4)
+        back = request_set(fd, protocol, sim)
+        time.sleep(0.4)
+        next_home = request_set(fd, protocol, sim)
+    finally:
+        os.close(fd)
+        sim.stop()
+    for channel in ("x", "y", "z"):
+        assert {s[channel][0] for s in home} == {model.value(channel, model.rest_of(1), 4)}
+        assert back[channel] == [model.value(channel, model.rest_of(1, 1), 4)]
+        assert next_home[channel] == [model.value(channel, model.rest_of(2), 4)]

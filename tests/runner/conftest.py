@@ -71,7 +71,8 @@ def warming_robot() -> Iterator[Simulator]:
         },
         gauge=GaugeSpec(resolution=0.0001, unit="in", low=-1.0, high=1.0),
     )
-    sim = Simulator(get_protocol("mitutoyo"), model, None, seed=11)
+    # Its sessions have no zero step: the robot returns between every two polls.
+    sim = Simulator(get_protocol("mitutoyo"), model, None, seed=11, returns_each_set=True)
     sim.start_pty()
     yield sim
     sim.stop()

@@ -383,6 +383,7 @@ def test_capture_prints_alarms_and_asks_their_causes_only_at_a_terminal(warming_
 
 
 def test_capture_summary_of_nine_cycles_is_provisional(simulator, tmp_path):
+    simulator.returns_each_set = True  # no zero step: the robot returns between two polls
     folder = tmp_path / "procedures"
     folder.mkdir()
     (folder / "cycles-only.toml").write_bytes(CYCLES_ONLY)

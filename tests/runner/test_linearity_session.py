@@ -104,10 +104,18 @@ def assert_contiguous(path: Path) -> None:
     def point_is(i: int, k: int) -> bool:
         return all(abs(points[i][c] - shown(name, k)) < 1e-7 for c, name in enumerate(channels))
 
-    # The stream began wherever the robot was: find that k, then every later point follows.
-    start = next((k for k in range(20_000) if all(point_is(i, k + i) for i in range(40))), None)
-    assert start is not None, "the first points are not consecutive sets of the simulator"
-    wrong = next((i for i in range(len(points)) if not point_is(i, start + i)), None)
+    # The robot may still stand at A (where it was zeroed) when the stream begins: those points
+    # show A within the indicators' own noise. From its first point of travel on, every point
+    # is the simulator's next set.
+    s_index = channels.index("s")
+    moved = next(i for i, point in enumerate(points) if abs(point[s_index]) > 0.001)
+    assert all(abs(point[s_index]) <= 0.001 for point in points[:moved])
+    first = max(moved - 1, 0)
+    start = next(
+        (k for k in range(20_000) if all(point_is(first + i, k + i) for i in range(40))), None
+    )
+    assert start is not None, "the first points of travel are not consecutive sets"
+    wrong = next((i for i in range(first, len(points)) if not point_is(i, start + i - first)), None)
     assert wrong is None, f"point {wrong} is missing, repeated or mixes two sets"
 
 

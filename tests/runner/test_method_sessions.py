@@ -13,9 +13,15 @@ from pathlib import Path
 import pytest
 from helpers import STATION, start_simulator, stop_simulator
 
+from station.instruments.gauge_bench import GaugeBenchModel
+from station.instruments.joint_model import faulty_arm
+from station.instruments.protocols import get_protocol
+from station.instruments.simulator import GaugeSpec, Simulator
 from station.session.gauge_register import coverage, coverage_lines, load_register
 from station.session.model import load_session
 from station.verdicts import analyze_session_file
+
+from .playing import play_capture
 
 
 def simulate(*args: str, protocol: str = "idh") -> tuple[subprocess.Popen, str]:
@@ -55,6 +61,44 @@ def capture(
     return next(folder.glob("*.jsonl")), done.stdout
 
 
+PACE = "0.15"
+RETURNS = 25
+"""Returns per joint (the procedure's target)."""
+"""Seconds ``station capture`` waits after each cycle and zero: the player moves the robot."""
+
+
+def played(
+    simulator: Simulator, returns: int, folder: Path, procedure: str, *extra: str, **options
+) -> tuple[subprocess.CompletedProcess[str], Path | None]:
+    """``station capture`` polling ``simulator`` (started here on a pty), the robot played
+    between its cycles (:mod:`tests.runner.playing`); the process and the session file."""
+    url = simulator.start_pty()
+    try:
+        done, _ = play_capture(
+            simulator,
+            returns,
+            [
+                *STATION,
+                "capture",
+                *("--trigger", "poll", "--every", PACE, "--procedure", procedure),
+                *("--port", url, "--protocol", simulator.protocol.name, "--robot", "KSC-7"),
+                *("--sessions", str(folder)),
+                *extra,
+            ],
+            **options,
+        )
+    finally:
+        simulator.stop()
+    return done, next(folder.glob("*.jsonl"), None)
+
+
+def bench(protocol: str = "idh", bias: float = 0.0) -> Simulator:
+    """The gauge bench: a 0.1 in block on a surface plate, the indicator's noise 5e-5 in."""
+    gauge = GaugeSpec(0.0001, -0.5, 1.0, "in", noise=0.00002)
+    model = GaugeBenchModel(0.1, bias=bias, noise=0.00005, gauge=gauge)
+    return Simulator(get_protocol(protocol), model, seed=0, channel_map={"1": "x"})
+
+
 def gauges(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run([*STATION, "gauges", *args], capture_output=True, text=True, timeout=60)
 
@@ -75,41 +119,24 @@ def analyze_json(path: Path) -> dict:
 def test_gauge_check_session_is_analysed_and_filed(
     tmp_path: Path, bias: float, capable: bool, protocol: str
 ):
-    simulator, url = simulate(
-        "--model",
-        "gauge-bench",
-        "--reference",
-        "0.1",
-        "--bias",
-        str(bias),
-        "--noise",
-        "0.00005",
-        protocol=protocol,
+    simulator = bench(protocol, bias)
+    done, path = played(
+        simulator,
+        25,
+        tmp_path / "sessions",
+        "gauge_check",
+        *("--cycles", "25", "--input", "gauge=MIT-0042", "--input", "reference=0.1"),
+        *("--input", "tolerance=0.004", "--input", "calibration_due=2099-01-01"),
     )
-    try:
-        path, summary = capture(
-            url,
-            tmp_path / "sessions",
-            "gauge_check",
-            "--cycles",
-            "25",
-            "--input",
-            "gauge=MIT-0042",
-            "--input",
-            "reference=0.1",
-            "--input",
-            "tolerance=0.004",
-            "--input",
-            "calibration_due=2099-01-01",
-            protocol=protocol,
-        )
-    finally:
-        stop_simulator(simulator)
+    assert done.returncode == 0, done.stderr
+    summary, url = done.stdout, simulator.url
     study = analyze_json(path)["gauge_check"]
     assert study["n"] == 25 and study["capable"] is capable
-    # A software zero reads the plate once: that reading's own error (noise, and the display's
-    # 0.0001 in step) is in every later reading, so the bias is known to about one step.
-    assert study["bias"] == pytest.approx(bias, abs=0.00003 if protocol == "idh" else 0.00015)
+    # The zero is the mean of several readings on the plate (a device zero: the gauge's own
+    # zero on its last reading there), so the bias is known to about one 0.0001 in step.
+    assert study["bias"] == pytest.approx(bias, abs=0.00015)
+    zero = load_session(path).zeroes[0]["channels"]["x"]
+    assert zero["n"] > 1 and zero["spread"] <= 0.0003
     # The capture summary is the kind's report, and the finished check filed itself in the
     # gauge register (the test's own: STATION_GAUGES), with the line it was read on.
     assert f"GAUGE CHECK (TYPE-1 STUDY): {'CAPABLE' if capable else 'NOT CAPABLE'}" in summary
@@ -129,39 +156,24 @@ def test_gauge_check_session_is_analysed_and_filed(
 
 @pytest.mark.parametrize("protocol", ["idh", "mitutoyo"])
 def test_joint_troubleshooting_session_names_the_faulty_joint(tmp_path: Path, protocol: str):
-    simulator, url = simulate(
-        "--model",
-        "joints",
-        "--faulty-joint",
-        "2",
-        "--joint-fault",
-        "backlash",
-        "--seed",
-        "5",
-        protocol=protocol,
+    gauge = GaugeSpec(0.0001, -0.5, 0.5, "in", noise=0.00003)
+    arm = faulty_arm(2, "backlash", size=4e-5, cycles=RETURNS, home_readings=1, gauge=gauge)
+    simulator = Simulator(get_protocol(protocol), arm, seed=5)
+    done, path = played(
+        simulator,
+        RETURNS,
+        tmp_path / "sessions",
+        "joint_troubleshooting",
+        *("--placements", "3", "--input", "1:lever=31.177"),
+        *("--input", "2:lever=31.241", "--input", "3:lever=16"),
     )
-    try:
-        path, summary = capture(
-            url,
-            tmp_path / "sessions",
-            "joint_troubleshooting",
-            "--placements",
-            "3",
-            "--input",
-            "1:lever=31.177",
-            "--input",
-            "2:lever=31.241",
-            "--input",
-            "3:lever=16",
-            protocol=protocol,
-        )
-    finally:
-        shown = stop_simulator(simulator)
-    assert "joint 3: move only joint 3" in shown
+    assert done.returncode == 0, done.stderr
+    summary = done.stdout
+    assert [z["placement"] for z in load_session(path).zeroes] == [1, 2, 3]
     document = analyze_json(path)
     assert document["procedure"] == "joint_troubleshooting"
     assert document["suspect"] == 2 and document["cause"] == "backlash"
-    assert all(j["n"] == 25 and j["lever_arm"] for j in document["joints"])
+    assert all(j["n"] == RETURNS and j["lever_arm"] for j in document["joints"])
     assert analyze_session_file(path).count == "3 joints"
     assert "SUSPECT: joint 2." in summary
 
@@ -210,19 +222,15 @@ def test_a_repeatability_session_says_which_gauge_check_covers_it(tmp_path: Path
     """The gauge check files MIT-0042 in the register; a repeatability session that names it on
     x records the check at its start, and its verdict (capture summary, analyze, the filed
     report) says so, while y and z, checked by nobody, warn."""
-    bench, bench_url = simulate("--model", "gauge-bench", "--reference", "0.1", "--noise", "5e-5")
-    try:
-        capture(
-            bench_url,
-            tmp_path / "checks",
-            "gauge_check",
-            "--cycles",
-            "25",
-            *("--input", "gauge=MIT-0042", "--input", "reference=0.1"),
-            *("--input", "tolerance=0.004"),
-        )
-    finally:
-        stop_simulator(bench)
+    done, _ = played(
+        bench(),
+        25,
+        tmp_path / "checks",
+        "gauge_check",
+        *("--cycles", "25", "--input", "gauge=MIT-0042", "--input", "reference=0.1"),
+        *("--input", "tolerance=0.004"),
+    )
+    assert done.returncode == 0, done.stderr
     fixture, url = simulate("--unit", "in", "--resolution", "0.0001")
     try:
         path, summary = capture(
@@ -295,24 +303,15 @@ def test_a_register_that_cannot_be_written_is_a_warning_not_a_lost_check(tmp_pat
     target.write_text("{}")
     link = tmp_path / "gauges.json"
     link.symlink_to(target)
-    bench, url = simulate("--model", "gauge-bench", "--reference", "0.1", "--noise", "5e-5")
-    try:
-        done = subprocess.run(
-            [
-                *STATION,
-                "capture",
-                *("--procedure", "gauge_check", "--port", url, "--protocol", "idh"),
-                *("--robot", "bench", "--sessions", str(tmp_path / "s"), "--cycles", "25"),
-                *("--every", "0.01"),
-                *("--input", "gauge=G-1", "--input", "reference=0.1", "--input", "tolerance=0.004"),
-            ],
-            capture_output=True,
-            text=True,
-            timeout=120,
-            env={**os.environ, "STATION_GAUGES": str(link)},
-        )
-    finally:
-        stop_simulator(bench)
+    done, _ = played(
+        bench(),
+        25,
+        tmp_path / "s",
+        "gauge_check",
+        *("--cycles", "25", "--input", "gauge=G-1", "--input", "reference=0.1"),
+        *("--input", "tolerance=0.004"),
+        env={**os.environ, "STATION_GAUGES": str(link)},
+    )
     assert done.returncode == 0, done.stderr
     assert "station: warning: the gauge register" in done.stderr
     assert "symbolic link" in done.stderr

@@ -271,9 +271,12 @@ def test_push_trigger_records_sets_without_capture_calls(gauges_for, tmp_path):
         assert cycles_seen == []
         zeroing = threading.Thread(target=lambda: runner.zero(timeout=30.0))
         zeroing.start()
-        # One press, once the software zero waits for it: no set is left over for the cycles.
-        assert wait_until_inside(zeroing, "wait_set"), "the zero never waited for a set"
-        sim.push(1)
+        # Three presses (the zero is their mean), once the zero listens for them: no set is
+        # left over for the cycles.
+        assert wait_until_inside(zeroing, "collect"), "the zero never listened for presses"
+        for _ in range(3):
+            sim.push(1)
+            time.sleep(0.05)
         zeroing.join(30)
         assert not zeroing.is_alive() and runner.state().current.kind == "check"
         runner.confirm()

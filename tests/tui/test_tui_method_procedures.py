@@ -1,10 +1,11 @@
 """The gauge check, per-joint troubleshooting and gain schedule through the TUI at 80×24, by
-keyboard, against ``station simulate`` (a real process on a real pty): set-up, every step of
+keyboard, against ``station simulate``'s set-ups (on a real pty): set-up, every step of
 the checklist, the captures, finish, and the summary with the kind's own report. The gauge
 check then stands in the gauge register, and a repeatability session's summary names it."""
 
 from __future__ import annotations
 
+import argparse
 import datetime as dt
 import json
 import os
@@ -14,11 +15,12 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from helpers import start_simulator, stop_simulator
 from textual.widgets import Input, Static
 
+from station.commands import simulate
 from station.session.gauge_register import load_register
 from station.tui.app import StationApp, StationConfig
+from station.tui.instruments import DemoFixture, track
 from station.tui.screens.checklist import ChecklistScreen
 from station.tui.screens.dashboard import DashboardScreen
 from station.tui.screens.summary import SummaryScreen, SummaryView
@@ -30,12 +32,20 @@ PROTOCOL = "mitutoyo"
 
 @pytest.fixture
 def simulator(request) -> Iterator[str]:
-    """``station simulate`` with the test's arguments (``request.param``); its URL."""
-    process, url = start_simulator("--protocol", PROTOCOL, *request.param)
+    """The simulated set-up ``station simulate`` builds from the test's arguments
+    (``request.param``), served on a real pty in this process so that the session moves its
+    robot where the steps say, as the demo does (the operator re-seats the block, moves the
+    joint); its URL."""
+    parser = argparse.ArgumentParser()
+    simulate.add_parser(parser.add_subparsers())
+    args = parser.parse_args(["simulate", "--protocol", PROTOCOL, *request.param])
+    simulator = simulate.build_simulator(args)
+    url = simulator.start_pty()
+    fixture = track(DemoFixture(url, PROTOCOL, dict(simulator.channel_map), simulator))
     try:
         yield url
     finally:
-        stop_simulator(process)
+        fixture.stop()
 
 
 def text_of(app: StationApp, selector: str) -> str:

@@ -31,12 +31,12 @@ session with one line naming both ("the gauges send steps of 0.001, which is mm 
 protocol; the session is in inches at 0.0001"); with ``--trigger push`` press DATA once (or
 the check waits ``--timeout`` and leaves it to the zero step, which checks the unit too).
 
-Pacing: ``--trigger poll`` needs ``--every S`` (at least S seconds between two cycles) or a
-terminal (Enter per cycle, after a prompt naming the cycle the file will record); without
-either it is refused before anything is written. ``--trigger arrival`` (the repeatability
-procedure's default on a polled protocol) reads the gauges continuously and takes a set each
-time the robot leaves the fixture and comes back to rest; a return that does not settle is a
-warning on stderr, and nothing is recorded for it.
+Pacing: ``--trigger poll`` needs ``--every S`` (at least S seconds between two cycles, and
+around a zero) or a terminal (Enter per cycle, after a prompt naming the cycle the file will
+record); without either it is refused before anything is written. ``--trigger arrival`` (the
+repeatability procedure's default on a polled protocol) reads the gauges continuously and takes
+a set each time the robot leaves the fixture and comes back to rest; a return that does not
+settle is a warning on stderr, and nothing is recorded for it.
 
 ``--resume FILE`` continues the session as it was set up: the line (``--port``, ``--protocol``,
 ``--map``) and how this run waits (``--timeout``, ``--attempts``, inputs) may be given; a
@@ -114,8 +114,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--every",
         metavar="S",
-        help="poll: at least S seconds between two cycles (without it, and without a "
-        "terminal to press Enter in, poll is refused)",
+        help="poll: at least S seconds between two cycles and around a zero (without it, and "
+        "without a terminal to press Enter in, poll is refused)",
     )
     parser.add_argument(
         "--map", metavar="1=x,2=y,3=z", help="device to station channels (default 1, 2, 3 ...)"

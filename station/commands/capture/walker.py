@@ -118,6 +118,11 @@ class Headless:
         self.runner.submit_input({f.name: given[f.name] for f in fields if f.name in given}, by=BY)
 
     def _zero(self, state: Any) -> None:
+        if self.every is not None:
+            # After a capture the robot is brought to where it is zeroed: --every paces that too.
+            delay = self._last_capture + self.every - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
         seen = self._readings_seen()
         try:
             self.runner.zero(by=BY, timeout=self.timeout)
@@ -144,6 +149,8 @@ class Headless:
             raise
         self._waiting = False
         self._moving_since = None
+        # The robot is started on its loop once it is zeroed: the first cycle is paced too.
+        self._last_capture = time.monotonic()
 
     def _stream(self, state: Any) -> None:
         if state.progress is not None and state.progress.complete:

@@ -16,8 +16,12 @@ if TYPE_CHECKING:
     from station.run.engine import Runner
 
 ZERO_TIMEOUT = 5.0
-ARRIVAL_ZERO_READINGS = 5
-"""Readings per channel of a zero step without ``readings`` under the ``arrival`` trigger."""
+ZERO_READINGS = 5
+"""Readings per channel of a zero step without ``readings`` (polled, or under ``arrival``)."""
+PUSH_ZERO_READINGS = 3
+"""DATA presses a zero step without ``readings`` asks for under the ``push`` trigger: each press
+sends one reading per gauge, and a technician presses three times with the robot still rather
+than ten (the zero is their mean; a gauge that moved between the presses is named)."""
 
 
 class ZeroStep(StepHandler):
@@ -30,17 +34,28 @@ class ZeroStep(StepHandler):
     def action(self, run: Runner, item: PlanItem) -> Action:
         return Action("zero", prompt=self.prompt(run, item))
 
+    def prompt(self, run: Runner, item: PlanItem) -> str:
+        text = super().prompt(run, item)
+        if run.setup.trigger != "push":
+            return text
+        presses = self.readings(run, item)
+        # A push gauge sends only when its DATA button (or foot switch) is pressed.
+        return f"{text} Press DATA {presses} times, the robot still: the zero is their mean."
+
     def confirm(self, run: Runner, item: PlanItem, by: str) -> None:
         # Confirming a zero step is zeroing: the engine releases its lock for the wait.
         run.zero(by=by)
 
     @staticmethod
     def default_readings(run: Runner) -> int:
-        """Readings per channel when the step does not say: with the ``arrival`` trigger the
-        robot is known to move between cycles, so the zero is a mean taken while every gauge
-        is still (a single reading could be taken mid-travel); otherwise one reading set (or
-        the gauge's own zero command), as before zero windows existed."""
-        return ARRIVAL_ZERO_READINGS if run.setup.trigger == "arrival" else 1
+        """Readings per channel when the step does not say: one reading is no zero (its noise
+        shifts every later reading), so always several, taken while every gauge is still: 5
+        polled or under ``arrival``, 3 DATA presses under ``push``."""
+        return PUSH_ZERO_READINGS if run.setup.trigger == "push" else ZERO_READINGS
+
+    def readings(self, run: Runner, item: PlanItem) -> int:
+        """Readings per channel this zero step takes: the step's own, else the default."""
+        return item.step.readings or self.default_readings(run)
 
     def zero(self, run: Runner, item: PlanItem, by: str, timeout: float) -> None:
         """The mean of the step's ``readings`` (when it gives them) per channel over its
@@ -58,7 +73,7 @@ class ZeroStep(StepHandler):
                 list(step.channels),
                 timeout,
                 unit=run.setup.resolved_unit,
-                readings=step.readings or self.default_readings(run),
+                readings=self.readings(run, item),
                 settle=step.settle if step.settle is not None else DEFAULT_ZERO_SETTLE,
                 still=step.still if step.still is not None else DEFAULT_ZERO_STILL,
             )
