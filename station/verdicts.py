@@ -27,7 +27,7 @@ from station.analysis.linearity import (
     linearity_summary,
     tolerance_from_limits,
 )
-from station.analysis.live import LiveAnalysis, LiveMonitor, Rejection
+from station.analysis.live import LiveAnalysis, LiveMonitor, LiveReadings, Rejection
 from station.analysis.report import format_accuracy, format_linearity
 from station.analysis.strokes import (
     StrokeProfile,
@@ -117,6 +117,24 @@ class LiveVerdict(Protocol):
     def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveVerdict:
         """A fresh live analysis of ``cycles`` keeping what is not a cycle (strokes), or
         taking that from ``session`` when given (resume)."""
+        ...
+
+    def copy(self) -> LiveCopy:
+        """What the analysis holds now, cheaply (no analysis: the engine takes it under its
+        lock); its ``snapshot()`` and ``result()`` equal this object's now and are computed
+        later, on another thread, while this one goes on taking cycles."""
+        ...
+
+
+class LiveCopy(Protocol):
+    """A live analysis as it was at one moment (:meth:`LiveVerdict.copy`)."""
+
+    def snapshot(self) -> Analysis:
+        """The analysis (StationError while there is nothing to analyse)."""
+        ...
+
+    def result(self) -> Any:
+        """The kind's own result, or None."""
         ...
 
 
@@ -565,6 +583,9 @@ class LiveCycles:
     def result(self) -> Any:
         return None
 
+    def copy(self) -> CyclesSoFar:
+        return CyclesSoFar(self.live.readings())
+
     def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveCycles:
         fresh = type(self)(self.config, self.channels, self.header)
         if fresh._monitor is not None and session is not None:
@@ -586,6 +607,21 @@ class LiveCycles:
         for values, number, *times in cycles:
             fresh.add_cycle(values, number, times[0] if times else None)
         return fresh
+
+
+@dataclass(frozen=True)
+class CyclesSoFar:
+    """The cycles of a :class:`LiveCycles` at one moment (its :meth:`~LiveCycles.copy`)."""
+
+    readings: LiveReadings
+
+    def snapshot(self) -> Analysis:
+        """The live analysis of these readings."""
+        return self.readings.snapshot()
+
+    def result(self) -> None:
+        """A kind of cycles has no result of its own."""
+        return None
 
 
 @dataclass(frozen=True)
@@ -651,6 +687,12 @@ class LiveStrokes:
         if result is None:
             raise StationError("no whole stroke yet: stream one first.")
         return linearity_summary(result.analysis)
+
+    def copy(self) -> LiveStrokes:
+        kept = type(self)(self.config, self.channels, self.header)
+        kept.profiles = list(self.profiles)
+        kept._result = self._result
+        return kept
 
     def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveStrokes:
         fresh = type(self)(self.config, self.channels, self.header)

@@ -27,15 +27,17 @@ Definitions and sources: ``reference/spc-extensions.md`` §3–§5.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+
+import numpy as np
+from scipy import stats
+from scipy.signal import lfilter
+from scipy.special import ndtr
 
 from station.analysis.capability import SpecLimits
 from station.analysis.descriptive import as_readings
-
-if TYPE_CHECKING:
-    import numpy as np
 
 #: Significance level of the normality, autocorrelation and trend tests.
 ALPHA = 0.05
@@ -78,7 +80,6 @@ def out_of_spec(
 ) -> OutOfSpec:
     """The readings below the LSL and above the USL (strictly), named by ``cycles`` (1, 2, 3 ...
     when None). Without limits nothing is out of specification."""
-    import numpy as np
 
     array = as_readings(values)
     labels = np.arange(1, array.size + 1) if cycles is None else np.asarray(cycles, dtype=int)
@@ -134,8 +135,6 @@ def normality(
     alpha: float = ALPHA,
 ) -> Normality:
     """Shapiro–Wilk (n ≤ 5000) or Anderson–Darling (larger n) test of normality."""
-    import numpy as np
-    from scipy import stats
 
     array = as_readings(values)
     n = int(array.size)
@@ -154,8 +153,6 @@ def normality(
             "readings make the test reject normal data more often"
         )
     if n <= SHAPIRO_MAX_N:
-        import warnings
-
         with warnings.catch_warnings():
             # A spread at the last digits of a float ("range zero") still has a p-value.
             warnings.simplefilter("ignore", UserWarning)
@@ -190,8 +187,6 @@ class PercentileCapability:
 
 
 def _quantiles(array: np.ndarray) -> tuple[str, tuple[float, float, float]]:
-    import numpy as np
-    from scipy import stats
 
     levels = [LOWER_QUANTILE, 0.5, UPPER_QUANTILE]
     if array.size >= EMPIRICAL_QUANTILES_FROM:
@@ -209,7 +204,6 @@ def percentile_capability(
     values: Iterable[float] | np.ndarray, limits: SpecLimits, threshold: float = 1.0
 ) -> PercentileCapability | None:
     """The percentile indices of the readings (None with fewer than 3 readings or no spread)."""
-    import numpy as np
 
     array = as_readings(values)
     if array.size < 3 or not float(np.ptp(array)) > 0:
@@ -268,7 +262,6 @@ AUTOCORRELATION_EXPLANATION = (
 
 def lag1(array: np.ndarray) -> float | None:
     """r₁ of an array (None without spread)."""
-    import numpy as np
 
     deviations = array - array.mean()
     # Products summed by numpy rather than np.dot: BLAS threads on a shared, loaded machine
@@ -285,8 +278,6 @@ def autocorrelation(
     sigma_within: float | None = None,
 ) -> Autocorrelation:
     """Lag-1 autocorrelation and its significance (see the module docstring)."""
-    import numpy as np
-    from scipy.special import ndtr
 
     array = as_readings(values)
     n = int(array.size)
@@ -354,8 +345,6 @@ def ewma_values(
 ) -> np.ndarray:
     """z_i = λx_i + (1 − λ)z_{i−1} with z_0 = ``center``, in one pass of ``scipy.signal.lfilter``
     (direct form: y[n] = b₀x[n] − a₁y[n−1], initial state (1 − λ)·z₀)."""
-    import numpy as np
-    from scipy.signal import lfilter
 
     x = np.asarray(points, dtype=float)
     if not x.size:
@@ -381,7 +370,6 @@ def ewma_chart(
     """The EWMA of the readings about ``center`` with limits from ``sigma`` (the within sigma)."""
     if not 0 < lam <= 1:
         raise ValueError("the EWMA weight must lie in (0, 1]")
-    import numpy as np
 
     array = as_readings(values)
     labels = np.arange(1, array.size + 1) if cycles is None else np.asarray(cycles, dtype=int)
@@ -428,8 +416,6 @@ def trend(
     confidence: float = 0.95,
 ) -> Trend:
     """The trend of the readings (see :class:`Trend`); ``times`` in seconds, one per reading."""
-    import numpy as np
-    from scipy import stats
 
     array = as_readings(values)
     n = int(array.size)
@@ -478,7 +464,6 @@ def drift(
     unit: str = "",
 ) -> Drift:
     """EWMA about the mean (σ the within sigma) and the trend on reading times."""
-    import numpy as np
 
     array = as_readings(values)
     chart = None

@@ -546,8 +546,8 @@ def linearity_summary(result: LinearityAnalysis) -> Analysis:
     return Analysis(
         channels=named,
         spatial=None,
-        hints=linearity_hints(result),
         config=result.config,
+        given_hints=linearity_hints(result),
     )
 
 

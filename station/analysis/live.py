@@ -69,9 +69,11 @@ from station.analysis.summary import (
     AnalysisConfig,
     ChannelAnalysis,
     PointCycles,
+    analyze_channel,
     combine,
     point_cycles,
 )
+from station.errors import StationError
 
 #: The longest window any rule looks back over (15 points: report rule 3, Nelson 7).
 RULE_WINDOW = 15
@@ -352,8 +354,6 @@ class LiveChannel:
         every reading has one), and return the updated figures."""
         x = float(value)
         if not math.isfinite(x):
-            from station.errors import StationError
-
             raise StationError(
                 f"{self.name}: reading {len(self._values) + 1} is not a finite number ({value!r})"
             )
@@ -620,24 +620,49 @@ class LiveChannel:
             self._ewma_run_start = None
         return tuple(found)
 
+    def readings(self) -> ChannelReadings:
+        """A copy of the readings so far, to analyse later or on another thread (O(n) list
+        copies: no analysis)."""
+        times = None if None in self._times else tuple(self._times)
+        return ChannelReadings(self.name, tuple(self._values), tuple(self._cycles), times)  # type: ignore[arg-type]
+
     def snapshot(self) -> ChannelAnalysis:
         """The full analysis of the readings so far: equal to the batch analysis (cached)."""
         if self._snapshot is None:
-            from station.analysis.summary import analyze_channel
-
             if not self._values:
-                from station.errors import StationError
-
                 raise StationError(f"channel {self.name!r} has no readings yet.")
-            times = None if None in self._times else self._times
-            self._snapshot = analyze_channel(
-                self.name,
-                self._values,
-                self.config,
-                self._cycles,
-                times,  # type: ignore[arg-type]
-            )
+            self._snapshot = self.readings().analysis(self.config)
         return self._snapshot
+
+
+@dataclass(frozen=True)
+class ChannelReadings:
+    """One channel's readings at one moment of a live analysis, with their cycles and times."""
+
+    name: str
+    values: tuple[float, ...]
+    cycles: tuple[int, ...]
+    times: tuple[float, ...] | None
+
+    def analysis(self, config: AnalysisConfig) -> ChannelAnalysis:
+        """The batch analysis of these readings (what :meth:`LiveChannel.snapshot` gives)."""
+        return analyze_channel(self.name, self.values, config, self.cycles, self.times)
+
+
+@dataclass(frozen=True)
+class LiveReadings:
+    """The readings of a :class:`LiveAnalysis` at one moment: its :meth:`snapshot` is the live
+    analysis's as it was then, computed without the live analysis (so its owner may go on
+    adding readings on another thread meanwhile)."""
+
+    config: AnalysisConfig
+    channels: tuple[ChannelReadings, ...]
+
+    def snapshot(self) -> Analysis:
+        """The whole analysis of these readings: equal to :meth:`LiveAnalysis.snapshot`."""
+        if not self.channels:
+            raise StationError("no readings yet: capture a cycle first.")
+        return combine({c.name: c.analysis(self.config) for c in self.channels}, self.config)
 
 
 class LiveAnalysis:
@@ -688,11 +713,16 @@ class LiveAnalysis:
             name: self.add(name, value, cycle, stamps.get(name)) for name, value in readings.items()
         }
 
+    def readings(self) -> LiveReadings:
+        """A copy of every channel's readings so far (channels with readings), to analyse
+        without this object: ``readings().snapshot()`` equals :meth:`snapshot` now."""
+        return LiveReadings(
+            self.config, tuple(live.readings() for live in self.channels.values() if live.n)
+        )
+
     def snapshot(self) -> Analysis:
         """The whole analysis so far (channels with readings): equal to the batch ``analyze``."""
         channels = {name: live.snapshot() for name, live in self.channels.items() if live.n}
         if not channels:
-            from station.errors import StationError
-
             raise StationError("no readings yet: capture a cycle first.")
         return combine(channels, self.config)

@@ -200,9 +200,20 @@ class Analysis:
 
     channels: dict[str, ChannelAnalysis]
     spatial: Spatial | None
-    hints: tuple[str, ...]
     config: AnalysisConfig
     excluded_cycles: tuple[int, ...] = ()
+    given_hints: tuple[str, ...] | None = None
+    """The hints of an analysis built with its own (a linearity summary's; none for a kind
+    whose report block says what its figures point to); None: the channels' hints."""
+
+    @cached_property
+    def hints(self) -> tuple[str, ...]:
+        """The verdict hints: :attr:`given_hints`, else every channel's (:func:`hints_of`).
+        Worked out on first use: the hint on non-normal readings fits a distribution (tens of
+        ms a channel), too slow for every live snapshot of a screen that shows no hints."""
+        if self.given_hints is not None:
+            return self.given_hints
+        return hints_of(list(self.channels.values()), self.config)
 
     @property
     def incapable_channels(self) -> list[str]:
@@ -514,7 +525,6 @@ def combine(
     return Analysis(
         channels=dict(channels),
         spatial=spatial_of(readings, config),
-        hints=hints_of(list(channels.values()), config),
         config=config,
         excluded_cycles=tuple(excluded_cycles),
     )
@@ -736,7 +746,5 @@ def to_json(analysis: Analysis) -> dict[str, Any]:
 
 def _numbered_in_order(cycles: Any) -> bool:
     """True when ``cycles`` is exactly 1, 2, ..., n."""
-    import numpy as np
-
     numbers = np.asarray(cycles)
     return bool(numbers.size == 0 or np.array_equal(numbers, np.arange(1, numbers.size + 1)))

@@ -39,6 +39,7 @@ class InstrumentIntake:
             target=self._take_in, name="runner intake", daemon=True
         )
         self._intake_thread.start()
+        self._start_analysis_thread()
         try:
             for reader in getattr(self.gauges, "readers", ()):
                 self._port_states[reader.url] = reader.state
