@@ -166,17 +166,17 @@ def analyze_accuracy(
 def accuracy_json(result: AccuracyAnalysis) -> dict[str, Any]:
     """The ``"accuracy"`` document of ``station analyze --json``: per axis across placements,
     each placement, the 3-D error's statistics, and the error per unit moved."""
-    from station.analysis.summary import _number, channel_to_json
+    from station.analysis.document import channel_to_json, json_number
 
     return {
         "axes": {
             axis: {
-                "average": _number(result.average[axis]),
-                "spread": _number(result.spread[axis]),
-                "range": _number(result.span[axis]),
+                "average": json_number(result.average[axis]),
+                "spread": json_number(result.spread[axis]),
+                "range": json_number(result.span[axis]),
                 "scale_error": None
                 if result.scale_error is None
-                else _number(result.scale_error[axis]),
+                else json_number(result.scale_error[axis]),
             }
             for axis in AXES
         },
@@ -186,16 +186,16 @@ def accuracy_json(result: AccuracyAnalysis) -> dict[str, Any]:
                 "n": p.n,
                 "pendant": None
                 if p.pendant is None
-                else {axis: _number(v) for axis, v in zip(AXES, p.pendant, strict=True)},
-                "distance": _number(p.distance),
-                "mean": {axis: _number(v) for axis, v in p.mean.items()},
-                "sd": {axis: _number(v) for axis, v in p.sd.items()},
-                "error_3d": _number(p.error_3d),
+                else {axis: json_number(v) for axis, v in zip(AXES, p.pendant, strict=True)},
+                "distance": json_number(p.distance),
+                "mean": {axis: json_number(v) for axis, v in p.mean.items()},
+                "sd": {axis: json_number(v) for axis, v in p.sd.items()},
+                "error_3d": json_number(p.error_3d),
             }
             for p in result.placements
         ],
         "error_3d": channel_to_json(result.error_3d),
         "per_unit": None
         if result.per_unit is None
-        else [[_number(v) for v in row] for row in result.per_unit],
+        else [[json_number(v) for v in row] for row in result.per_unit],
     }

@@ -431,7 +431,7 @@ def analyze_linearity(
 
 
 def _number(value: float | None) -> float | None:
-    from station.analysis.summary import _number as json_number
+    from station.analysis.document import json_number
 
     return json_number(value)
 
@@ -440,7 +440,7 @@ def linearity_json(result: LinearityAnalysis) -> dict[str, Any]:
     """The ``"linearity"`` document of ``station analyze --json`` (straightness in the readings'
     unit; ``h.ls``/``h.mz`` at the top are the largest over strokes; ``path_repeatability`` per
     channel is the largest 3·s along the bar)."""
-    from station.analysis.summary import channel_to_json
+    from station.analysis.document import channel_to_json
 
     channels = result.channels
     document: dict[str, Any] = {

@@ -17,7 +17,7 @@ branch. Its rules:
   in words) when they first appear; an alarm is new unless it flags a cycle an alarm of the
   same rule and channel already flagged (a run growing by a point is one alarm). The live
   analysis judges against frozen (phase II) limits, so a written alarm never goes away, and a
-  replay of the file (:func:`~station.analysis.live.replay_live_alarms`) gives exactly the
+  replay of the file (:func:`~station.analysis.monitor.replay_live_alarms`) gives exactly the
   alarm events written. The retrospective chart (limits from every reading) is not
   journalled: it is a function of the readings, and the reports compute it and mark each of
   its alarms live or retrospective.

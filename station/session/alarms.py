@@ -7,7 +7,7 @@
   procedure's ``causes``), ``text`` (required for "other"), ``action`` (the corrective action,
   optional), ``by`` (optional). :func:`ack_fields` checks them before the engine writes them.
 * :func:`live_events` turns a session's readings and rejections (in journal order) into the
-  input of :func:`station.analysis.live.replay_live_alarms`: a replay gives the recorded live
+  input of :func:`station.analysis.monitor.replay_live_alarms`: a replay gives the recorded live
   alarms (same channel, rule, points, cycles and text, in the same order).
 """
 
@@ -23,7 +23,7 @@ from station.plain import plain
 from station.procedures import DEFAULT_CAUSES, OTHER_CAUSE
 
 if TYPE_CHECKING:
-    from station.analysis.live import ReadingSet, Rejection
+    from station.analysis.monitor import ReadingSet, Rejection
     from station.session.model import Session
 
 
@@ -159,7 +159,7 @@ def recorded_alarms(session: Session) -> tuple[RecordedAlarm, ...]:
 
 def live_events(session: Session) -> list[ReadingSet | Rejection]:
     """The session's readings and rejections in journal order, as the live analysis saw them."""
-    from station.analysis.live import ReadingSet, Rejection
+    from station.analysis.monitor import ReadingSet, Rejection
 
     events: list[ReadingSet | Rejection] = []
     for event in session.events:
