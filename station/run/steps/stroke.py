@@ -48,8 +48,10 @@ class StrokeStep(StepHandler):
         return {
             # One deadband rule, recorded: the live split and any later re-split use this value.
             "deadband": stroke_deadband(setup.resolved_resolution),
-            # A linearity verdict is final from the strokes the step asks for at least.
-            "strokes_min": stroke_counts(setup, step)[1],
+            # A linearity verdict is final from the strokes the procedure's step asks for at
+            # least (a trial run the set-up shortens stays provisional, as a short run of
+            # cycles does).
+            "strokes_min": int(step.count_min or step.count_target or 1),
         }
 
     def counts(self, run: Runner, item: PlanItem) -> tuple[int, int]:
