@@ -301,8 +301,7 @@ class StationApp(App[int]):
 
     def warm_up_analysis(self) -> None:
         """Load the analysis (numpy, scipy: about half a second) on a thread, early, so that
-        neither the set-up screen nor the first captured cycle waits for it. Kept off the start
-        path on purpose: the home screen asks for it once it has painted."""
+        the first captured cycle is not drawn late. Kept off the start path on purpose."""
         if not self._warmed_up:
             self._warmed_up = True
             self.run_worker(_import_analysis, thread=True, group="warm-up", exit_on_error=False)
@@ -630,8 +629,8 @@ class StationApp(App[int]):
 
 
 def _import_analysis() -> None:
-    """What the set-up screen and the first live analysis would otherwise import on the UI
-    thread: the engine, the analysis kinds and the statistics behind them (numpy, scipy)."""
+    """What the first live analysis would otherwise import on the UI thread."""
     import scipy.special  # noqa: F401 - capability's confidence bound
+    import scipy.stats  # noqa: F401 - the hints' tests
 
-    import station.run  # noqa: F401 - the engine, the analysis kinds, scipy.stats and .signal
+    import station.analysis.summary  # noqa: F401

@@ -23,10 +23,6 @@ from station.tui.text import shown, shown_line
 if TYPE_CHECKING:
     from station.tui.app import StationApp
 
-WARM_UP_DELAY = 0.5
-"""Seconds after the home screen mounts before the analysis loads on a thread (the set-up
-screen needs it): the first screen reaches the terminal before that thread competes with it."""
-
 INTRODUCTION = (
     "Tests a robot by the 1990 NASA/KSC method: repeatability (25–30 returns to a taught "
     "point), relative accuracy (two fixtures) or linearity (strokes along a bar), judged "
@@ -70,10 +66,8 @@ class HomeScreen(Screen[None]):
         yield Footer()
 
     def on_mount(self) -> None:
-        """Fill the choices from the sessions folder; soon after, load the analysis on a thread
-        (the set-up screen needs it and would otherwise load it as it opens)."""
+        """Fill the choices from the sessions folder."""
         self.reload()
-        self.set_timer(WARM_UP_DELAY, self.app.warm_up_analysis)
 
     def reload(self) -> None:
         """Read the sessions folder again and rebuild the list."""
