@@ -32,9 +32,6 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
-from scipy.signal import lfilter
-from scipy.special import ndtr
 
 from station.analysis.capability import SpecLimits
 from station.analysis.descriptive import as_readings
@@ -135,6 +132,7 @@ def normality(
     alpha: float = ALPHA,
 ) -> Normality:
     """Shapiro–Wilk (n ≤ 5000) or Anderson–Darling (larger n) test of normality."""
+    from scipy import stats
 
     array = as_readings(values)
     n = int(array.size)
@@ -187,6 +185,7 @@ class PercentileCapability:
 
 
 def _quantiles(array: np.ndarray) -> tuple[str, tuple[float, float, float]]:
+    from scipy import stats
 
     levels = [LOWER_QUANTILE, 0.5, UPPER_QUANTILE]
     if array.size >= EMPIRICAL_QUANTILES_FROM:
@@ -278,6 +277,7 @@ def autocorrelation(
     sigma_within: float | None = None,
 ) -> Autocorrelation:
     """Lag-1 autocorrelation and its significance (see the module docstring)."""
+    from scipy.special import ndtr
 
     array = as_readings(values)
     n = int(array.size)
@@ -345,6 +345,7 @@ def ewma_values(
 ) -> np.ndarray:
     """z_i = λx_i + (1 − λ)z_{i−1} with z_0 = ``center``, in one pass of ``scipy.signal.lfilter``
     (direct form: y[n] = b₀x[n] − a₁y[n−1], initial state (1 − λ)·z₀)."""
+    from scipy.signal import lfilter
 
     x = np.asarray(points, dtype=float)
     if not x.size:
@@ -416,6 +417,7 @@ def trend(
     confidence: float = 0.95,
 ) -> Trend:
     """The trend of the readings (see :class:`Trend`); ``times`` in seconds, one per reading."""
+    from scipy import stats
 
     array = as_readings(values)
     n = int(array.size)
@@ -483,3 +485,12 @@ def drift(
             "during the session; look for warm-up, a loose fixture or gauge, and repeat"
         )
     return Drift(chart, found, message)
+
+
+def import_scipy() -> None:
+    """Import the parts of scipy the analysis loads where it uses them (a screen that imports
+    the analysis does not wait for scipy): call it on a worker thread early, so that the first
+    use does not import it where waiting costs (an engine's intake, under its lock)."""
+    import scipy.signal  # noqa: F401 - the EWMA (diagnostics)
+    import scipy.special  # noqa: F401 - the confidence bounds (capability, constants, hints)
+    import scipy.stats  # noqa: F401 - the tests (diagnostics, gauge check, joints)
