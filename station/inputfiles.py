@@ -14,6 +14,7 @@ import stat
 from pathlib import Path
 
 from station.errors import StationError
+from station.plain import plain
 
 MEBIBYTE = 1 << 20
 
@@ -81,6 +82,4 @@ def read_input_bytes(path: str | os.PathLike[str], what: str, limit: int) -> byt
 
 def _shown(path: Path) -> str:
     # A file name over the system's limit is itself the error; keep the sentence one line.
-    from station.plain import plain
-
     return plain(str(path), limit=300)

@@ -21,6 +21,7 @@ Imported by :mod:`station.verdicts` (at its end), which is all it takes to regis
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -36,6 +37,8 @@ from station.analysis.summary import Analysis, analyze
 from station.errors import StationError
 from station.procedures import analysis_needs
 from station.session import method_reports
+from station.session.gauge_register import filed_line, register_path
+from station.session.tables import require_columns
 from station.verdicts import (
     AnalysisKind,
     Judgement,
@@ -86,8 +89,6 @@ def _pooled(inputs: KindInputs, channels: Sequence[str], config: Any) -> Analysi
 def fitted(lines: Sequence[str], width: int) -> tuple[str, ...]:
     """The report lines, each longer than ``width`` wrapped under its own indent (the TUI's
     summary column is narrower than the 80 columns of a printed report)."""
-    import textwrap
-
     out: list[str] = []
     for line in lines:
         if len(line) <= width:
@@ -154,8 +155,6 @@ def _gauge_check(inputs: KindInputs) -> Judgement:
         "  its Cp is Cg and its Cpk is Cgk.",
     ]
     if inputs.header is not None and inputs.header.get("session"):
-        from station.session.gauge_register import filed_line
-
         notes.append(f"  {filed_line(str(inputs.header['session']))}")
     return Judgement(analysis, study, (fitted([*study.lines(), *notes], inputs.width),))
 
@@ -164,8 +163,6 @@ def file_gauge_check(path: Path, *, register_file: Path | None = None) -> list[s
     """File the study of the finished gauge-check session at ``path`` in the gauge register
     (under the gauge id typed at its input step, with the line and device channel it was read
     on); the sentence to show. StationError when it cannot."""
-    from station.session.gauge_register import register_path
-
     source = load_session_source(path)
     report = report_session(source)
     study: GaugeCheck = report.result
@@ -227,8 +224,6 @@ def _joint_troubleshooting(inputs: KindInputs) -> Judgement:
 
 def _gain_inputs(inputs: KindInputs) -> tuple[Any, dict[str, Any]]:
     if inputs.table is not None:
-        from station.session.tables import require_columns
-
         table = inputs.table
         q = require_columns(table, ("q",), "a gains table")["q"]
         gains = {n: v for n, v in table.channels.items() if n.lower() != "q"}

@@ -53,11 +53,31 @@ def format_value(value: float | None, resolution: float | None, *, signed: bool 
     return "+" + text[1:] if text.startswith("-") and not text.strip("-0.") else text
 
 
-def format_spread(value: float | None, resolution: float | None) -> str:
-    """A spread (σ, range) at one decimal more than the gauge shows, unsigned."""
+def figure_decimals(resolution: float | None) -> int:
+    """Decimals of a figure computed from readings (a mean, σ, a limit, a control line, a zero
+    taken as a mean): one beyond the gauge's step (0.0001 -> 5), so an average keeps the digit
+    it resolves. Every screen and report that shows statistics writes every figure in the
+    session's unit with these decimals, readings included, so one screen has one format."""
+    return value_decimals(resolution) + 1
+
+
+def format_figure(value: float | None, resolution: float | None, *, signed: bool = True) -> str:
+    """A figure at :func:`figure_decimals`: signed for a position (``+0.00012``, a mean, a
+    limit, an offset), unsigned for a spread (``signed=False``: σ, range); ``-`` when
+    undefined. Never in scientific notation."""
     if value is None or not math.isfinite(value):
         return NOT_AVAILABLE
-    return f"{value:.{value_decimals(resolution) + 1}f}"
+    decimals = figure_decimals(resolution)
+    if not signed:
+        return f"{value:.{decimals}f}"
+    text = f"{value:+.{decimals}f}"
+    # -0.000004 at five decimals would read "-0.00000": a zero has no sign worth showing.
+    return "+" + text[1:] if text.startswith("-") and not text.strip("-0.") else text
+
+
+def format_spread(value: float | None, resolution: float | None) -> str:
+    """A spread (σ, range) at one decimal more than the gauge shows, unsigned."""
+    return format_figure(value, resolution, signed=False)
 
 
 def format_index(value: float | None) -> str:
@@ -245,9 +265,10 @@ def limits_text(lsl: float | None, usl: float | None, nominal: float | None = No
 
 
 def zero_text(channels: Mapping[str, Any], resolution: float | None) -> str:
-    """A zero event's channels in one line: ``x +0.0003 (10 readings, spread 0.0001)`` each
+    """A zero event's channels in one line: ``x +0.00030 (10 readings, spread 0.00010)`` each
     (the offset subtracted from later readings; ``device`` when the gauge zeroed itself), or
-    ``x +0.0003 (1 reading)`` for an old one-reading zero."""
+    ``x +0.00030 (1 reading)`` for an old one-reading zero (the offset at
+    :func:`figure_decimals`, like the spread beside it)."""
     parts = []
     for channel, spec in channels.items():
         spec = spec if isinstance(spec, Mapping) else {}
@@ -255,7 +276,7 @@ def zero_text(channels: Mapping[str, Any], resolution: float | None) -> str:
         if spec.get("method") == "device":
             shown = "device zero"
         else:
-            shown = format_value(_number(spec.get("offset")), resolution)
+            shown = format_figure(_number(spec.get("offset")), resolution)
         if isinstance(n, int) and n > 1:
             spread = format_spread(_number(spec.get("spread")), resolution)
             detail = f"{n} readings, spread {spread}"
@@ -270,7 +291,7 @@ def _number(value: Any) -> float | None:
 
 
 def zero_taken(zeroes: Iterable[Mapping[str, Any]], resolution: float | None) -> str:
-    """``Zero taken: x +0.0003 (5 readings, spread 0.00010); ...``: the zero in force per
+    """``Zero taken: x +0.00030 (5 readings, spread 0.00010); ...``: the zero in force per
     channel (each channel's last ``zero`` event), or '' when the session has none."""
     latest: dict[str, Any] = {}
     for event in zeroes:

@@ -22,3 +22,30 @@ def test_readme_test_command_is_what_ci_runs():
     test_command = ".venv/bin/python -m pytest"
     assert test_command in readme
     assert test_command in ci
+
+
+def _loaded_after(code: str) -> set[str]:
+    """The top-level packages loaded in a fresh interpreter after running ``code``."""
+    probe = f"import sys\n{code}\nprint(' '.join(sorted({{m.split('.')[0] for m in sys.modules}})))"
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, cwd=ROOT)
+    assert done.returncode == 0, done.stderr
+    return set(done.stdout.split("\n")[-2].split())
+
+
+def test_station_help_loads_no_numpy():
+    """README, Development: a command imports what it needs inside its ``run``."""
+    loaded = _loaded_after(
+        "from station.cli import main\ntry:\n    main(['--help'])\nexcept SystemExit:\n    pass"
+    )
+    assert "station" in loaded and "numpy" not in loaded
+
+
+def test_importing_the_engine_and_the_record_screens_loads_no_scipy():
+    """README, Development: the analysis and the record import scipy where they use it, so a
+    screen that imports the engine or the record on the UI thread does not wait for scipy (the
+    TUI loads it on a worker thread)."""
+    loaded = _loaded_after(
+        "import station.run, station.verdicts, station.method_kinds\n"
+        "import station.record.history, station.record.compare, station.record.render"
+    )
+    assert "numpy" in loaded and "scipy" not in loaded

@@ -22,12 +22,19 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+import numpy as np
+
+from station.analysis.document import channel_to_json, json_number
+from station.analysis.summary import (
+    Analysis,
+    AnalysisConfig,
+    ChannelAnalysis,
+    analyze,
+    analyze_channel,
+)
 from station.errors import StationError
-
-if TYPE_CHECKING:
-    from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis
 
 AXES = ("x", "y", "z")
 #: The name of the 3-D error channel.
@@ -70,8 +77,6 @@ class AccuracyAnalysis:
 
 
 def _pendant(value: Any) -> tuple[float, float, float]:
-    import numpy as np
-
     coordinates = tuple(float(v) for v in value)
     if len(coordinates) != 3 or not all(np.isfinite(coordinates)):
         raise StationError(
@@ -92,10 +97,6 @@ def analyze_accuracy(
     to the fixture placements ``placements`` (numbers, one per row). ``pendant`` maps a
     placement number to the teach pendant's X, Y, Z there.
     """
-    import numpy as np
-
-    from station.analysis.summary import analyze, analyze_channel
-
     missing = [axis for axis in AXES if axis not in errors]
     if missing:
         raise StationError(
@@ -166,8 +167,6 @@ def analyze_accuracy(
 def accuracy_json(result: AccuracyAnalysis) -> dict[str, Any]:
     """The ``"accuracy"`` document of ``station analyze --json``: per axis across placements,
     each placement, the 3-D error's statistics, and the error per unit moved."""
-    from station.analysis.document import channel_to_json, json_number
-
     return {
         "axes": {
             axis: {

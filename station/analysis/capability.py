@@ -23,15 +23,14 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from statistics import NormalDist
+
+import numpy as np
 
 from station.analysis.charts import check_subgroup
 from station.analysis.charts import sigma_within as estimate_sigma_within
 from station.analysis.descriptive import as_readings, mean_and_sd
 from station.errors import StationError
-
-if TYPE_CHECKING:
-    import numpy as np
 
 
 def _check_limit(name: str, value: float | None) -> None:
@@ -137,7 +136,7 @@ def _check_confidence(confidence: float) -> float:
 
 def cp_interval(cp: float, n: int, confidence: float = 0.95) -> tuple[float, float]:
     """Two-sided chi-square confidence interval on Cp from ``n`` readings (qcc, SAS)."""
-    from scipy.special import chdtri
+    from scipy.special import chdtri  # on first use: see README, Development
 
     alpha = 1 - _check_confidence(confidence)
     if n < 2:
@@ -175,8 +174,6 @@ def cpk_lower_bound(cpk: float, n: int, confidence: float = 0.95) -> float:
 def normal_quantile(p: float) -> float:
     """The standard normal quantile (the standard library's, Wichura's AS 241 to double
     precision: the same figure as scipy's ndtri, without loading scipy.special)."""
-    from statistics import NormalDist
-
     return NormalDist().inv_cdf(p)
 
 
@@ -195,8 +192,6 @@ def capability(
     overrides it with a known value, e.g. the sigma of a phase-I chart or a pooled sigma.
     ``confidence`` is the level of the one-sided ``cpk_lower`` bound.
     """
-    import numpy as np
-
     if not isinstance(limits, SpecLimits):
         raise TypeError("limits must be a SpecLimits")
     array = as_readings(values)

@@ -20,14 +20,12 @@ import math
 import operator
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+
+import numpy as np
 
 from station.analysis.constants import SIGMA_MULTIPLE, c4, chart_factors, d2
 from station.analysis.descriptive import as_readings
 from station.errors import StationError
-
-if TYPE_CHECKING:
-    import numpy as np
 
 LARGEST_RANGE_SUBGROUP = 10
 """Subgroups up to this size get an X-bar-R chart; larger ones an X-bar-S chart."""
@@ -115,8 +113,6 @@ def subgroups(values: Iterable[float] | np.ndarray, subgroup: int) -> np.ndarray
 
 def moving_ranges(values: Iterable[float] | np.ndarray) -> np.ndarray:
     """|x_i - x_(i-1)| for i = 2..n (n - 1 values)."""
-    import numpy as np
-
     return np.abs(np.diff(as_readings(values)))
 
 
@@ -126,8 +122,6 @@ def _spread(array: np.ndarray, size: int, kind: str) -> tuple[np.ndarray, float,
     Moving ranges and MR-bar / d2(2) for I-MR, subgroup ranges and R-bar / d2(n) for X-bar-R,
     subgroup SDs and S-bar / c4(n) for X-bar-S.
     """
-    import numpy as np
-
     if size == 1:
         if array.size < 2:
             return None

@@ -17,6 +17,8 @@ import math
 from dataclasses import dataclass
 from functools import cache
 
+import numpy as np
+
 SIGMA_MULTIPLE = 3.0
 """The k of "k-sigma" control limits used throughout (the report's UCL = X-bar + 3 sigma)."""
 
@@ -35,8 +37,7 @@ def _check_size(n: int, smallest: int) -> int:
 @cache
 def _range_moments(n: int) -> tuple[float, float]:
     """(E[R], SD[R]) of the range of n iid N(0, 1) values, by 1-D and 2-D quadrature."""
-    import numpy as np
-    from scipy.special import ndtr
+    from scipy.special import ndtr  # on first use: see README, Development
 
     nodes, weights = np.polynomial.legendre.leggauss(_NODES)
     x = _HALF_WIDTH * nodes

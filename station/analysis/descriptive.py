@@ -16,12 +16,10 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+
+import numpy as np
 
 from station.errors import StationError
-
-if TYPE_CHECKING:
-    import numpy as np
 
 
 def as_readings(values: Iterable[float] | np.ndarray, what: str = "reading") -> np.ndarray:
@@ -31,8 +29,6 @@ def as_readings(values: Iterable[float] | np.ndarray, what: str = "reading") -> 
     1-based, as the operator numbers cycles. A 2-D array (one row per subgroup) is read row
     by row, which is the order the readings were taken in.
     """
-    import numpy as np
-
     try:
         array = np.asarray(values, dtype=float)
     except (TypeError, ValueError) as error:
@@ -68,8 +64,6 @@ def _scaled_moments(array: np.ndarray) -> tuple[float, float, float, float]:
     Deviations are divided by their largest magnitude before they are raised to powers, so
     readings of 1e200 or 1e-200 neither overflow nor underflow.
     """
-    import numpy as np
-
     lowest, highest = float(array.min()), float(array.max())
     if lowest == highest:
         return lowest, 0.0, 0.0, 0.0
@@ -105,8 +99,6 @@ def modes_at_resolution(
     Empty when no value occurs more than once. Values are returned in ascending order as
     multiples of the resolution (so 0.00019999 read at 0.0001 counts as 0.0002).
     """
-    import numpy as np
-
     array = as_readings(values)
     if array.size < 2:
         return ()
@@ -215,8 +207,6 @@ def histogram(
     specification limits when given. Without a resolution the width is a 1-2-5 step giving
     about sqrt(n) bins (at most ``max_bins``).
     """
-    import numpy as np
-
     array = as_readings(values)
     if int(max_bins) != max_bins or max_bins < 1:
         raise StationError(f"max_bins must be a whole number of at least 1, got {max_bins}")

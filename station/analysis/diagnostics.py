@@ -35,6 +35,7 @@ import numpy as np
 
 from station.analysis.capability import SpecLimits
 from station.analysis.descriptive import as_readings
+from station.text import format_figure
 
 #: Significance level of the normality, autocorrelation and trend tests.
 ALPHA = 0.05
@@ -147,7 +148,8 @@ def normality(
     ties = None
     if resolution and resolution > sd / 4:
         ties = (
-            f"the gauge step {resolution:g} is over a quarter of sigma ({sd:.3g}): tied "
+            f"the gauge step {resolution:g} is over a quarter of sigma "
+            f"({format_figure(sd, resolution, signed=False)}): tied "
             "readings make the test reject normal data more often"
         )
     if n <= SHAPIRO_MAX_N:
@@ -464,8 +466,10 @@ def drift(
     cycles: Sequence[int] | np.ndarray | None = None,
     name: str = "",
     unit: str = "",
+    resolution: float | None = None,
 ) -> Drift:
-    """EWMA about the mean (σ the within sigma) and the trend on reading times."""
+    """EWMA about the mean (σ the within sigma) and the trend on reading times; the trend in
+    the message is written at the gauge ``resolution``'s figure decimals when given."""
 
     array = as_readings(values)
     chart = None
@@ -475,8 +479,11 @@ def drift(
     message = None
     subject = f"{name} " if name else ""
     if found.significant and found.per_span is not None and found.p_value is not None:
+        per_span = (
+            format_figure(found.per_span, resolution) if resolution else two_digits(found.per_span)
+        )
         message = (
-            f"{subject}drifts {two_digits(found.per_span)}{' ' + unit if unit else ''} per "
+            f"{subject}drifts {per_span}{' ' + unit if unit else ''} per "
             f"{found.span} cycles, {p_phrase(found.p_value)}: let the robot warm up and repeat"
         )
     elif chart is not None and chart.signals:

@@ -33,6 +33,9 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
+import numpy as np
+from numpy.polynomial import Chebyshev, Polynomial, chebyshev
+
 from station.errors import StationError
 
 Criterion = Literal["loo", "aicc"]
@@ -92,9 +95,6 @@ class GainFit:
 
     def evaluate(self, q: Any) -> Any:
         """K(q) from the Chebyshev form (well-conditioned), for a number or an array."""
-        import numpy as np
-        from numpy.polynomial import Chebyshev
-
         series = Chebyshev(np.asarray(self.chebyshev), domain=list(self.domain))
         return series(np.asarray(q, dtype=float))
 
@@ -138,16 +138,12 @@ class GainSchedule:
 
 
 def _design(x: Any, order: int) -> Any:
-    from numpy.polynomial import chebyshev
-
     return chebyshev.chebvander(x, order)
 
 
 def _score(x: Any, k: Any, order: int, scale: float) -> tuple[OrderScore, Any, Any]:
     """Least squares of ``k`` on the Chebyshev basis of order ``order`` at scaled ``x``: the
     score, the coefficients and the residuals."""
-    import numpy as np
-
     n = len(x)
     design = _design(x, order)
     q_factor, r_factor = np.linalg.qr(design)
@@ -201,8 +197,6 @@ def _overshoot(series: Any, q: Any) -> float:
     at them, relative to the range of the fitted gains (0 for a curve monotone between each
     pair). A smooth schedule with a peak between two positions swings a little (about the
     square of the spacing over the span); Runge oscillation swings a lot."""
-    import numpy as np
-
     at_positions = series(q)
     span = float(np.ptp(at_positions))
     if span == 0:
@@ -236,9 +230,6 @@ def fit_gain(
     StationError for fewer than 2 positions, repeated positions, values that are not finite, or
     an order the positions cannot fix (order ≥ n).
     """
-    import numpy as np
-    from numpy.polynomial import Chebyshev, Polynomial
-
     q = np.asarray(positions, dtype=float).ravel()
     k = np.asarray(gains, dtype=float).ravel()
     if q.size != k.size:

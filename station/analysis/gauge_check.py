@@ -24,6 +24,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from station.errors import StationError
 
 #: K: the share of the tolerance (in %) the gauge's spread may take.
@@ -194,8 +196,7 @@ def gauge_check(
     Raises StationError for fewer than 2 readings, a value that is not finite, or a tolerance or
     resolution that is not positive.
     """
-    import numpy as np
-    from scipy import stats
+    from scipy import stats  # on first use: see README, Development
 
     readings = np.asarray(values, dtype=float).ravel()
     if readings.size < 2:

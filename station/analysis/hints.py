@@ -22,10 +22,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from statistics import NormalDist
 
 from station.analysis.capability import Capability, SpecLimits
 from station.analysis.descriptive import Descriptive
 from station.analysis.rules import Alarm, number_list, rule_name
+from station.text import format_figure
 
 #: |a₁| at or above this is "close to 1 or higher" (report §2.7.1).
 SKEW_HINT = 0.8
@@ -33,8 +35,10 @@ SKEW_HINT = 0.8
 RESOLUTION_RATIO = 10.0
 
 
-def _figure(value: float, unit: str) -> str:
-    return f"{value:+.3g} {unit}".rstrip()
+def _figure(value: float, resolution: float | None, unit: str) -> str:
+    """A figure as every screen writes it (one decimal beyond the gauge step, never
+    scientific), with its unit."""
+    return f"{format_figure(value, resolution)} {unit}".rstrip()
 
 
 def _where(alarm: Alarm) -> str:
@@ -52,11 +56,9 @@ def t_quantile(p: float, degrees: int) -> float:
     Cornish-Fisher series in 1/degrees (Abramowitz & Stegun 26.7.5, four terms), exact to
     double precision there and without loading scipy for a large file."""
     if degrees < _T_SERIES_FROM:
-        from scipy.special import stdtrit
+        from scipy.special import stdtrit  # on first use: see README, Development
 
         return float(stdtrit(degrees, p))
-    from statistics import NormalDist
-
     z = NormalDist().inv_cdf(p)
     g1 = (z**3 + z) / 4
     g2 = (5 * z**5 + 16 * z**3 + 3 * z) / 96
@@ -125,23 +127,28 @@ def channel_hints(
     if descriptive.mean is not None and offset_is_clear(descriptive, nominal):
         offset = descriptive.mean - nominal
         # "off nominal (+0 in)" reads oddly; the nominal is named only when it is not zero.
-        where = "off nominal" if nominal == 0 else f"off the nominal {_figure(nominal, unit)}"
+        where = (
+            "off nominal"
+            if nominal == 0
+            else f"off the nominal {_figure(nominal, resolution, unit)}"
+        )
         zero = (
-            f"±{ZERO_COVERAGE * zero_uncertainty:.2g} {unit}".rstrip()
+            f"±{format_figure(ZERO_COVERAGE * zero_uncertainty, resolution, signed=False)} "
+            f"{unit}".rstrip()
             if zero_uncertainty is not None
             else ""
         )
         if zero_uncertainty is not None and zero_explains(descriptive, nominal, zero_uncertainty):
             hints.append(
-                f"{name}: the average is {_figure(offset, unit)} {where}, within what the "
-                f"zero's own uncertainty ({zero}) explains: every reading carries the zero "
-                "taken, so zero again from more readings (the robot still at the fixture) "
+                f"{name}: the average is {_figure(offset, resolution, unit)} {where}, within "
+                f"what the zero's own uncertainty ({zero}) explains: every reading carries the "
+                "zero taken, so zero again from more readings (the robot still at the fixture) "
                 "before blaming the robot."
             )
         else:
             beyond = f", beyond the zero's own uncertainty ({zero})" if zero else ""
             hints.append(
-                f"{name}: the average is {_figure(offset, unit)} {where}, "
+                f"{name}: the average is {_figure(offset, resolution, unit)} {where}, "
                 f"more than chance explains with {descriptive.n} readings{beyond}; the report "
                 "attributes this to the linearisation of the inverse kinematics or to the "
                 "ambient temperature."
@@ -174,8 +181,9 @@ def channel_hints(
         and (limits.usl - limits.lsl) < RESOLUTION_RATIO * resolution
     ):
         steps = (limits.usl - limits.lsl) / resolution
+        tolerance = _figure(limits.usl - limits.lsl, resolution, unit).lstrip("+")
         hints.append(
-            f"{name}: the tolerance {_figure(limits.usl - limits.lsl, unit).lstrip('+')} spans "
+            f"{name}: the tolerance {tolerance} spans "
             f"only {steps:.3g} gauge steps of {resolution:g} (fewer than "
             f"{RESOLUTION_RATIO:g}); the gauge is too coarse for this verdict: use a finer "
             "indicator."

@@ -32,9 +32,12 @@ Definitions: ``reference/spc-extensions.md`` §8.
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
 
 from station.errors import StationError
 
@@ -149,8 +152,6 @@ class JointsAnalysis:
     def lines(self, unit: str = "") -> list[str]:
         """The report block: the ranking table, the tests and the verdict (at most 80
         columns)."""
-        import textwrap
-
         angular = self.angular
         lines = [
             "PER-JOINT TROUBLESHOOTING (each joint moved alone, the others held)",
@@ -195,8 +196,6 @@ class JointsAnalysis:
 
 
 def _joint_numbers(values: Any) -> Any:
-    import numpy as np
-
     numbers = np.asarray(values, dtype=float).ravel()
     if numbers.size and (not np.all(np.isfinite(numbers)) or np.any(numbers != np.round(numbers))):
         raise StationError("the joint column must hold whole joint numbers (1, 2, 3, ...).")
@@ -218,8 +217,7 @@ def analyze_joints(
     from the cube (the base) spreads it more for the same angular repeatability, and without
     the lever arms the comparison is of what the fixture sees, which is what the verdict judges
     but not a fault of the joint."""
-    import numpy as np
-    from scipy import stats
+    from scipy import stats  # on first use: see README, Development
 
     missing = [axis for axis in AXES if axis not in readings]
     if missing:

@@ -32,18 +32,25 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+import numpy as np
+
+from station.analysis.capability import SpecLimits
+from station.analysis.document import channel_to_json
+from station.analysis.document import json_number as _number
 from station.analysis.strokes import (
     DIRECTIONS,
     StrokeProfile,
 )
+from station.analysis.summary import (
+    Analysis,
+    AnalysisConfig,
+    ChannelAnalysis,
+    analyze_channel,
+)
 from station.errors import StationError
-
-if TYPE_CHECKING:
-    import numpy as np
-
-    from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis
+from station.text import format_figure
 
 #: The indicator channels of the linearity set-up, and the scale.
 INDICATORS = ("h", "v")
@@ -71,8 +78,6 @@ class Straightness:
 
 
 def _profile(s: Any, d: Any) -> tuple[np.ndarray, np.ndarray]:
-    import numpy as np
-
     s = np.asarray(s, dtype=float).ravel()
     d = np.asarray(d, dtype=float).ravel()
     if s.shape != d.shape:
@@ -93,8 +98,6 @@ def _profile(s: Any, d: Any) -> tuple[np.ndarray, np.ndarray]:
 
 def _hull_chain(points: np.ndarray) -> np.ndarray:
     """One monotone chain (Andrew): the lower hull of points sorted by x, then y."""
-    import numpy as np
-
     chain: list[int] = []
     for i in range(len(points)):
         while len(chain) >= 2:
@@ -110,8 +113,6 @@ def _hull_chain(points: np.ndarray) -> np.ndarray:
 
 def convex_hull(s: np.ndarray, d: np.ndarray) -> np.ndarray:
     """The vertices of the convex hull of the points (s, d), as an (m, 2) array."""
-    import numpy as np
-
     points = np.unique(np.column_stack([s, d]), axis=0)  # sorted by s, then d
     if len(points) <= 2:
         return points
@@ -131,8 +132,6 @@ def minimum_zone(s: Any, d: Any) -> tuple[float, tuple[float, float]]:
     Exact: the width w(b) is convex in b with breaks only at hull-edge slopes; the minimum is at
     one of them, found by binary search on the sorted slopes (w evaluated on the hull vertices).
     """
-    import numpy as np
-
     s, d = _profile(s, d)
     hull = convex_hull(s, d)
     edges = np.diff(np.concatenate([hull, hull[:1]]), axis=0)
@@ -156,8 +155,6 @@ def minimum_zone(s: Any, d: Any) -> tuple[float, tuple[float, float]]:
 
 def least_squares_line(s: Any, d: Any) -> tuple[float, float]:
     """The least-squares line d = a + b·s, as ``(a, b)``."""
-    import numpy as np
-
     s, d = _profile(s, d)
     s_mean, d_mean = float(s.mean()), float(d.mean())
     span = float(np.ptp(s))
@@ -222,8 +219,6 @@ def path_repeatability(
     Each stroke contributes the mean of its points in a bin (so strokes sampled at different
     positions or rates weigh the same).
     """
-    import numpy as np
-
     pairs = [(np.asarray(s, dtype=float), np.asarray(d, dtype=float)) for s, d in profiles]
     if isinstance(bins, int):
         if bins < 1:
@@ -326,9 +321,6 @@ class LinearityAnalysis:
 def _straightness_config(
     config: AnalysisConfig | None, channels: Sequence[str], tolerance: float | None
 ) -> AnalysisConfig:
-    from station.analysis.capability import SpecLimits
-    from station.analysis.summary import AnalysisConfig
-
     base = config or AnalysisConfig()
     limits = {} if tolerance is None else {c: SpecLimits(usl=tolerance) for c in channels}
     # The straightness is a width, never negative: its nominal (the ideal) is 0.
@@ -352,10 +344,6 @@ def analyze_linearity(
     ``config`` supplies the resolution, unit, rule set and threshold (its limits are replaced
     by the tolerance).
     """
-    import numpy as np
-
-    from station.analysis.summary import analyze_channel
-
     if not profiles:
         raise StationError(
             "no complete stroke along the bar: the scale must travel from one end to the other."
@@ -430,18 +418,10 @@ def analyze_linearity(
     )
 
 
-def _number(value: float | None) -> float | None:
-    from station.analysis.document import json_number
-
-    return json_number(value)
-
-
 def linearity_json(result: LinearityAnalysis) -> dict[str, Any]:
     """The ``"linearity"`` document of ``station analyze --json`` (straightness in the readings'
     unit; ``h.ls``/``h.mz`` at the top are the largest over strokes; ``path_repeatability`` per
     channel is the largest 3·s along the bar)."""
-    from station.analysis.document import channel_to_json
-
     channels = result.channels
     document: dict[str, Any] = {
         c: {"ls": _number(result.ls[c]), "mz": _number(result.mz[c])} for c in channels
@@ -504,6 +484,11 @@ def linearity_hints(result: LinearityAnalysis) -> tuple[str, ...]:
     """What stands out in a linearity analysis, in the report's manner of hints."""
     hints: list[str] = []
     unit = f" {result.unit}" if result.unit else ""
+    resolution = result.config.resolution
+
+    def figure(value: float) -> str:
+        return format_figure(value, resolution, signed=False)
+
     for c in result.channels:
         values = [r.straightness[c].mz for r in result.strokes]
         if result.tolerance is not None:
@@ -511,7 +496,8 @@ def linearity_hints(result: LinearityAnalysis) -> tuple[str, ...]:
             if over:
                 hints.append(
                     f"{c}: {over} of {len(values)} strokes exceed the straightness tolerance "
-                    f"{result.tolerance:g}{unit} (largest {max(values):.4g}{unit}): the path "
+                    f"{figure(result.tolerance)}{unit} (largest {figure(max(values))}{unit}): the "
+                    "path "
                     "bends more than allowed; compare with the bar's own straightness."
                 )
         if len(result.directions) == 2:
@@ -520,7 +506,8 @@ def linearity_hints(result: LinearityAnalysis) -> tuple[str, ...]:
             if low > 0 and high > 1.5 * low:
                 hints.append(
                     f"{c}: the straightness differs by direction (mean MZ A→B "
-                    f"{forward.mz_mean[c]:.6g}, B→A {backward.mz_mean[c]:.6g}{unit}): look at "
+                    f"{figure(forward.mz_mean[c])}, B→A {figure(backward.mz_mean[c])}{unit}): "
+                    "look at "
                     "backlash or the controller's tracking in one direction."
                 )
         alarms = result.judged[c].alarms
@@ -537,8 +524,6 @@ def linearity_summary(result: LinearityAnalysis) -> Analysis:
     """An :class:`~station.analysis.summary.Analysis` whose channels are the per-stroke MZ
     straightness of each indicator (what ``station analyze`` and a verdict judge), with the
     linearity hints instead of the repeatability ones (an offset from 0 is no fault here)."""
-    from station.analysis.summary import Analysis
-
     named = {
         c: replace(judged, name=f"{c} straightness (MZ, one reading per stroke)")
         for c, judged in result.judged.items()

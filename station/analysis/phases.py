@@ -16,14 +16,13 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
+
+import numpy as np
 
 from station.analysis.constants import SIGMA_MULTIPLE
-from station.analysis.diagnostics import EWMA_LAMBDA, EWMA_WIDTH
+from station.analysis.diagnostics import EWMA_LAMBDA, EWMA_WIDTH, ewma_values
 from station.analysis.rules import Alarm, check_rules, number_list
-
-if TYPE_CHECKING:
-    import numpy as np
+from station.errors import StationError
 
 #: Chart points after which the live limits freeze when the procedure names no minimum count.
 DEFAULT_FREEZE_AFTER = 20
@@ -44,12 +43,8 @@ class FrozenLimits:
         for name in ("center", "ucl", "lcl"):
             value = getattr(self, name)
             if not math.isfinite(value):
-                from station.errors import StationError
-
                 raise StationError(f"the baseline's {name} {value!r} is not a finite number.")
         if not self.lcl < self.center < self.ucl:
-            from station.errors import StationError
-
             raise StationError(
                 f"baseline limits LCL {self.lcl:g} < centre {self.center:g} < UCL {self.ucl:g} "
                 "do not hold: give a centre line between the limits."
@@ -132,10 +127,6 @@ def ewma_alarms(
 ) -> EwmaAlarms:
     """The EWMA of ``points`` about the frozen centre (z₀ = centre, σ the frozen point sigma):
     one alarm per run of points beyond its limits."""
-    import numpy as np
-
-    from station.analysis.diagnostics import ewma_values
-
     if not len(points):
         return EwmaAlarms((), None, None, 0)
     z = ewma_values(points, frozen.center, lam)
@@ -207,8 +198,6 @@ def baseline_from_json(value: object) -> ControlBaseline | None:
                 float(spec["center"]), float(spec["ucl"]), float(spec["lcl"]), source
             )
         except (KeyError, TypeError, ValueError):
-            from station.errors import StationError
-
             raise StationError(
                 f"the baseline of channel {channel!r} needs numbers center, ucl and lcl."
             ) from None

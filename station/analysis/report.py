@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 
 from station.analysis.capability import Capability, SpecLimits
 from station.analysis.descriptive import Histogram
+from station.analysis.diagnostics import p_phrase
 from station.analysis.rules import number_list, rule_name
 from station.analysis.spatial import Spatial
 from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis
@@ -176,8 +177,6 @@ def _capability_lines(
 def format_diagnostics(channel: ChannelAnalysis, decimals: int, width: int = 80) -> list[str]:
     """Normality (and the percentile indices when it is rejected), lag-1 autocorrelation with
     the within- and overall-sigma indices side by side, and drift (trend and EWMA)."""
-    from station.analysis.diagnostics import p_phrase
-
     lines: list[str] = []
     normal = channel.normality
     if normal is not None:
@@ -280,7 +279,7 @@ def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int 
             ("NOMINAL", signed(channel.nominal, decimals)),
             ("LOWER SPEC", signed(None if limits is None else limits.lsl, decimals)),
             ("TOTAL NUMBER OF PIECES", str(n)),
-            ("SIGMA", signed(d.sd, decimals)),
+            ("SIGMA", unsigned(d.sd, decimals)),
             ("RANGE", unsigned(d.range, decimals)),
         ],
         width,
@@ -444,16 +443,21 @@ def format_linearity(
     spread = max((result.mz[c] for c in channels), default=0.0) or None
     decimals = decimals_for(config.resolution, spread)
     unit = f" {config.unit}" if config.unit else ""
-    tolerance = "not given" if result.tolerance is None else f"{result.tolerance:g}{unit}"
+    tolerance = (
+        "not given" if result.tolerance is None else f"{unsigned(result.tolerance, decimals)}{unit}"
+    )
     lines = _wrap(
         f"LINEARITY (report §2.9; {len(result.strokes)} strokes; straightness tolerance "
         f"{tolerance})",
         width,
-    ) + [
-        "  LS: peak-to-valley about the least-squares line; MZ: minimum zone (ISO 1101);",
-        "  both measured along the indicator axis.",
-        "",
-    ]
+    )
+    lines += _wrap(
+        "LS: peak-to-valley about the least-squares line; MZ: minimum zone (ISO 1101); "
+        "both measured along the indicator axis.",
+        width,
+        indent="  ",
+    )
+    lines.append("")
     header = ["STROKE", "DIR", "POINTS"] + [
         f"{c} {kind}" for c in channels for kind in ("LS", "MZ")
     ]
@@ -481,7 +485,7 @@ def format_linearity(
     lines.append("")
     for c in channels:
         path = result.path[c]
-        at = "" if path.at is None else f" at s = {path.at:.{max(decimals - 2, 1)}f}"
+        at = "" if path.at is None else f" at s = {unsigned(path.at, decimals)}"
         lines += _wrap(
             f"{c}: largest straightness LS {unsigned(result.ls[c], decimals)}, MZ "
             f"{unsigned(result.mz[c], decimals)}{unit}; path repeatability (largest 3s along "
@@ -538,11 +542,12 @@ def format_accuracy(result: AccuracyAnalysis, config: AnalysisConfig, width: int
             signed(result.average[axis], decimals),
             unsigned(result.spread[axis], decimals),
             unsigned(result.span[axis], decimals),
-            "-" if result.scale_error is None else f"{result.scale_error[axis]:+.2e}",
+            # Parts per million of the distance moved: plain decimals, never 1e-05 notation.
+            "-" if result.scale_error is None else f"{result.scale_error[axis] * 1e6:+.1f}",
         ]
         for axis in ("x", "y", "z")
     ]
-    lines += _table(["AXIS", "AVERAGE", "SIGMA", "RANGE", "ERROR/UNIT MOVED"], rows, width)
+    lines += _table(["AXIS", "AVERAGE", "SIGMA", "RANGE", "ERROR PER MOVE (ppm)"], rows, width)
     d = result.error_3d.descriptive
     lines += _wrap(
         f"3-D error sqrt(x^2 + y^2 + z^2) per reading: mean {unsigned(d.mean, decimals)}, "

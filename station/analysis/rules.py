@@ -38,13 +38,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+
+import numpy as np
 
 from station.analysis.descriptive import as_readings
 from station.errors import StationError
-
-if TYPE_CHECKING:
-    import numpy as np
 
 RULE_SETS: tuple[str, ...] = ("report", "western-electric", "nelson")
 
@@ -78,8 +76,6 @@ class _Context:
 
 def _runs(condition: np.ndarray, length: int) -> np.ndarray:
     """True where ``condition`` has held for at least ``length`` consecutive items up to here."""
-    import numpy as np
-
     index = np.arange(condition.size)
     last_break = np.maximum.accumulate(np.where(condition, -1, index))
     return (index - last_break) >= length
@@ -87,8 +83,6 @@ def _runs(condition: np.ndarray, length: int) -> np.ndarray:
 
 def _window_counts(condition: np.ndarray, width: int) -> np.ndarray:
     """How many of the ``width`` items ending here hold; 0 before a full window exists."""
-    import numpy as np
-
     totals = np.concatenate(([0], np.cumsum(condition, dtype=np.int64)))
     counts = np.zeros(condition.size, dtype=np.int64)
     if condition.size >= width:
@@ -117,8 +111,6 @@ def _same_side(length: int) -> Callable[[_Context], Flags]:
 
 def _shift_to_points(flags_on_steps: np.ndarray, offset: int, size: int) -> np.ndarray:
     """Flags indexed by difference (or change of direction) moved onto the point that ends it."""
-    import numpy as np
-
     shifted = np.zeros(size, dtype=bool)
     shifted[offset : offset + flags_on_steps.size] = flags_on_steps
     return shifted
@@ -126,8 +118,6 @@ def _shift_to_points(flags_on_steps: np.ndarray, offset: int, size: int) -> np.n
 
 def _trend(length: int) -> Callable[[_Context], Flags]:
     def rule(ctx: _Context) -> Flags:
-        import numpy as np
-
         steps = np.diff(ctx.points)
         size = ctx.points.size
         return {
@@ -140,8 +130,6 @@ def _trend(length: int) -> Callable[[_Context], Flags]:
 
 def _alternating(length: int) -> Callable[[_Context], Flags]:
     def rule(ctx: _Context) -> Flags:
-        import numpy as np
-
         directions = np.sign(np.diff(ctx.points))
         turns = directions[1:] * directions[:-1] < 0
         return {0: _shift_to_points(_runs(turns, length - 2), 2, ctx.points.size)}
@@ -471,8 +459,6 @@ def check_rules(
             f"control limits with centre {center} and sigma {sigma} cannot be checked: "
             "sigma must be a finite number >= 0"
         )
-    import numpy as np
-
     ctx = _Context(values, float(center), float(sigma))
     fmt = _formatter(float(sigma), unit)
     found: list[tuple[int, int, Alarm]] = []

@@ -13,12 +13,11 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Literal
+from typing import Any, Literal
+
+import numpy as np
 
 from station.errors import StationError
-
-if TYPE_CHECKING:
-    import numpy as np
 
 A_TO_B = "A→B"
 B_TO_A = "B→A"
@@ -111,8 +110,6 @@ def turning_points(s: Any, deadband: float) -> list[int]:
     ``deadband`` (:class:`Hysteresis`, so noise and dwell at an end do not make false
     reversals). The first and last entries are where the travel starts and where it last
     ends."""
-    import numpy as np
-
     s = np.asarray(s, dtype=float)
     if s.size == 0:
         return []
@@ -133,8 +130,6 @@ def _end_level(s: np.ndarray, index: int, deadband: float) -> float:
     """The scale's level at an end of travel: the median of the run of points around the
     extreme ``index`` within half the deadband of it (the dwell). The extreme itself is
     biased by noise; the dwell's median is not."""
-    import numpy as np
-
     near = np.abs(s - s[index]) <= deadband / 2
     first = last = index
     while first > 0 and near[first - 1]:
@@ -161,8 +156,6 @@ def split_strokes(
     half the whole travel): a partial pass at the start or the end is dropped. ``a_to_b`` is
     the sign of the scale's count from A to B (+1: it counts up from A).
     """
-    import numpy as np
-
     s = np.asarray(s, dtype=float).ravel()
     if s.size < 2:
         return []
@@ -204,8 +197,6 @@ def trim_dwell(s: Any, deadband: float | None = None) -> np.ndarray:
     :func:`split_strokes` leaves it out: points within a tenth of the ``deadband`` of an end's
     level, but for the last point before leaving and the first on arriving). A stroke split
     live is trimmed, never split again."""
-    import numpy as np
-
     s = np.asarray(s, dtype=float).ravel()
     everything = np.arange(s.size)
     if s.size < 2 or not np.all(np.isfinite(s)) or float(np.ptp(s)) == 0:
@@ -352,8 +343,6 @@ def profiles_from_stream(
     dwell_band: float | None = None,
 ) -> list[StrokeProfile]:
     """Split a stream (the scale ``s`` and the indicators, point by point) into strokes."""
-    import numpy as np
-
     s = np.asarray(s, dtype=float).ravel()
     arrays = {name: np.asarray(values, dtype=float).ravel() for name, values in channels.items()}
     for name, values in arrays.items():
@@ -393,8 +382,6 @@ def profiles_from_table(
     are kept, numbered 1, 2, 3, ... in order; ``recorded`` keeps the number they came under.
     A recorded stroke without a complete pass is left out.
     """
-    import numpy as np
-
     numbers = np.asarray(stroke, dtype=float).ravel()
     s = np.asarray(s, dtype=float).ravel()
     arrays = {name: np.asarray(values, dtype=float).ravel() for name, values in channels.items()}

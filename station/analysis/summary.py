@@ -35,6 +35,7 @@ from station.analysis.diagnostics import (
     drift,
     normality,
     out_of_spec,
+    p_phrase,
     percentile_capability,
 )
 from station.analysis.hints import channel_hints
@@ -409,6 +410,7 @@ def analyze_channel(
             cycles=label_array,
             name=name,
             unit=config.unit,
+            resolution=config.resolution,
         ),
         frozen=frozen,
         phase_rules=(config.rule_set, config.unit, config.subgroup),
@@ -468,7 +470,7 @@ def diagnostic_hints(channel: ChannelAnalysis) -> list[str]:
         ppk = channel.percentile.ppk
         hints.append(
             f"{channel.name}: the readings are not normal ({channel.normality.test}, "
-            f"p = {channel.normality.p_value:.3g}): judge by the percentile index "
+            f"{p_phrase(channel.normality.p_value)}): judge by the percentile index "
             f"Ppk (percentile) {'undefined' if ppk is None else f'{ppk:.2f}'} as well as Cpk."
         )
     return hints

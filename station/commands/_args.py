@@ -109,6 +109,22 @@ def limit_value(text: str | None, option: str, side: str) -> float | None:
     return value
 
 
+def parse_limit(text: str) -> tuple[str, float | None, float | None]:
+    """Split ``CH=LSL:USL`` (either side may be empty) into channel, lsl, usl."""
+    channel, equals, bounds = text.partition("=")
+    lsl_text, colon, usl_text = bounds.partition(":")
+    if not equals or not colon or not channel.strip():
+        raise StationError(
+            f"--limit {text!r} is not CH=LSL:USL; write e.g. --limit x=-0.001:0.001 "
+            "(or x=:0.001 for an upper limit only)."
+        )
+    lsl = limit_value(lsl_text, f"--limit {channel.strip()} lower limit", "lower")
+    usl = limit_value(usl_text, f"--limit {channel.strip()} upper limit", "upper")
+    if lsl is None and usl is None:
+        raise StationError(f"--limit {text!r} gives neither a lower nor an upper limit.")
+    return channel.strip(), lsl, usl
+
+
 LIMIT_MAGNITUDE = 1e150
 """Limits, like readings, stay within ±1e150 so the capability arithmetic stays finite."""
 RESOLUTION_RANGE = (1e-12, 1e6)

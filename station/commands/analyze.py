@@ -14,6 +14,7 @@ from station.commands._args import (
     bounded_int,
     bounded_number,
     limit_value,
+    parse_limit,
     parse_number,
 )
 from station.errors import StationError
@@ -139,25 +140,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
-def parse_limit(text: str) -> tuple[str, float | None, float | None]:
-    """Split ``CH=LSL:USL`` (either side may be empty) into channel, lsl, usl."""
-    channel, equals, bounds = text.partition("=")
-    lsl_text, colon, usl_text = bounds.partition(":")
-    if not equals or not colon or not channel.strip():
-        raise StationError(
-            f"--limit {text!r} is not CH=LSL:USL; write e.g. --limit x=-0.001:0.001 "
-            "(or x=:0.001 for an upper limit only)."
-        )
-    lsl = limit_value(lsl_text, f"--limit {channel.strip()} lower limit", "lower")
-    usl = limit_value(usl_text, f"--limit {channel.strip()} upper limit", "upper")
-    if lsl is None and usl is None:
-        raise StationError(f"--limit {text!r} gives neither a lower nor an upper limit.")
-    return channel.strip(), lsl, usl
-
-
 def is_session_file(path: Path) -> bool:
     """True when the file begins like a station session file (or it is named .jsonl)."""
-    from station.session.model import looks_like_session
+    from station.session.lines import looks_like_session
 
     if path.suffix.lower() == ".jsonl":
         return True

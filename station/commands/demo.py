@@ -95,7 +95,8 @@ def run(args: argparse.Namespace) -> int:
         fixture = lab.fixture(args.procedure)
         config = StationConfig(
             sessions_dir=folder / "demo",
-            sessions_reason=f"the demo folder under {folder} ({reason})",
+            # The path above already names the folder: say only why it is this one.
+            sessions_reason=f"the demo's own folder in the sessions folder, {reason}",
             procedure_dirs=tuple(Path(p) for p in args.procedures),
             demo=DemoPort(
                 url=fixture.url,
@@ -120,7 +121,7 @@ def _check_demo_choice(args: argparse.Namespace) -> None:
     here with a sentence (the TUI would open on it and wait forever)."""
     from station.errors import StationError
     from station.procedures import discover_procedures
-    from station.tui.screens.setup import DEMO_TRIAL_MINIMUM, count_field
+    from station.tui.screens.setup_form import DEMO_TRIAL_MINIMUM, count_field
 
     catalog = discover_procedures(args.procedures)
     if args.procedure not in catalog.ids():

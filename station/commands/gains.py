@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from station.errors import StationError
 from station.plain import plain
+from station.session.durable import write_text_durably
 
 if TYPE_CHECKING:
     from station.analysis.gain_schedule import GainFit, GainSchedule
@@ -163,23 +163,14 @@ def format_fit(fit: GainFit, *, plot: bool = True) -> list[str]:
 
 
 def write_c_header(text: str, target: Path, source: Path) -> None:
-    """Write ``text`` to ``target``: a temporary file in the same folder, then a rename (never a
-    half-written header); a symlink at ``target`` is replaced, not followed; never the input."""
-    if target.exists() and source.exists() and target.resolve() == source.resolve():
-        raise StationError(f"--c {target} is the input file; name another file for the header.")
+    """Write ``text`` to ``target`` in full or not at all (the station's one durable writer:
+    never through a symlink, never over the input file)."""
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise StationError(f"--c {target}: folder {folder} does not exist.")
-    temporary = folder / f".{target.name}.{os.getpid()}.tmp"
     try:
-        descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644)
-        with os.fdopen(descriptor, "w", encoding="ascii") as stream:
-            stream.write(text)
-            stream.flush()
-            os.fsync(stream.fileno())
-        os.replace(temporary, target)
+        write_text_durably(target, text, not_over=source, mode=0o644)
     except OSError as error:
-        temporary.unlink(missing_ok=True)
         raise StationError(f"cannot write {target}: {error.strerror or error}.") from None
 
 

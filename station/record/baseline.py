@@ -29,7 +29,7 @@ from typing import Any
 
 from station.errors import StationError
 from station.record.source import AnalysedSession, analyse_session
-from station.session.durable import fsync_folder, make_folders
+from station.session.durable import make_folders, write_text_durably
 
 FORMAT = "station-baseline/1"
 _UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
@@ -101,27 +101,6 @@ def make_baseline(analysed: AnalysedSession) -> dict[str, Any]:
     }
 
 
-def _write_new(path: Path, text: str) -> None:
-    """Write ``text`` to a private temporary file beside ``path`` (created exclusively, never
-    following a link), sync it and rename it over ``path``; then sync the folder."""
-    make_folders(path.parent)
-    if path.is_symlink():
-        raise StationError(f"{path} is a symbolic link; remove it, then set the baseline again.")
-    partial = path.with_name(f".{path.name}.{os.getpid()}.partial")
-    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
-    fd = os.open(partial, flags, 0o644)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(partial, path)
-    except BaseException:
-        partial.unlink(missing_ok=True)
-        raise
-    fsync_folder(path.parent)
-
-
 def store_baseline(robot: str, session_path: str | Path) -> dict[str, Any]:
     """Record the session at ``session_path`` as ``robot``'s baseline and return the record.
     Refused when the session is of another robot, unfinished, torn or not capable."""
@@ -133,8 +112,14 @@ def store_baseline(robot: str, session_path: str | Path) -> dict[str, Any]:
         )
     record = make_baseline(analysed)
     path = baseline_path(robot)
+    text = json.dumps(record, indent=2, ensure_ascii=False) + "\n"
     try:
-        _write_new(path, json.dumps(record, indent=2, ensure_ascii=False) + "\n")
+        make_folders(path.parent)
+        if path.is_symlink():
+            raise StationError(
+                f"{path} is a symbolic link; remove it, then set the baseline again."
+            )
+        write_text_durably(path, text, mode=0o644)
     except OSError as error:
         raise StationError(f"cannot write the baseline {path}: {error.strerror}") from None
     return record

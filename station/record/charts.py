@@ -15,6 +15,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from station.record.content import parse_time
 from station.record.source import AnalysedSession
 
@@ -65,8 +67,6 @@ def _figure(width: float = 7.0, height: float = 3.2) -> Any:
 
 def histogram_chart(name: str, channel: Any, unit: str) -> Any:
     """The readings' histogram with LSL, USL, nominal and the mean marked."""
-    import numpy as np
-
     figure = _figure()
     axes = figure.add_subplot()
     values = np.asarray(channel.readings, dtype=float)
@@ -89,8 +89,6 @@ def histogram_chart(name: str, channel: Any, unit: str) -> Any:
 def control_chart(name: str, channel: Any, xlabel: str = "cycle") -> Any:
     """The location chart: points by cycle (or stroke), centre line, control limits, alarms
     circled in red."""
-    import numpy as np
-
     chart = channel.chart
     figure = _figure()
     axes = figure.add_subplot()
@@ -127,8 +125,6 @@ def control_chart(name: str, channel: Any, xlabel: str = "cycle") -> Any:
 
 def offsets_chart(analysis: Any, unit: str) -> Any:
     """The x, y, z readings in 3-D with the nominal and the mean (the offset) marked."""
-    import numpy as np
-
     spatial = analysis.spatial
     channels = analysis.channels
     names = [n for n in channels if n.lower() in ("x", "y", "z")]
@@ -153,8 +149,6 @@ def offsets_chart(analysis: Any, unit: str) -> Any:
 def linearity_chart(channel: str, analysed: AnalysedSession, unit: str) -> Any:
     """Every stroke's deviation along the bar (grey), the widest stroke in colour with its
     least-squares line and its minimum zone (two parallel lines)."""
-    import numpy as np
-
     result = analysed.report.result  # type: ignore[union-attr]
     profiles = {p.number: p for p in analysed.profiles}
     figure = _figure()
@@ -191,8 +185,6 @@ def drift_chart(analysed: AnalysedSession, unit: str) -> Any | None:
     """Each channel's accepted readings against the time since the first (seconds, minutes or
     hours, as the session's length suits), with its least-squares trend; None with fewer than
     three timed cycles."""
-    import numpy as np
-
     session = analysed.session
     numbers = session.accepted_cycles
     if len(numbers) < 3:

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from station.errors import StationError
 from station.record.content import decimals_for
 from station.record.source import analyse_session
@@ -117,8 +119,7 @@ def compare_axis(
     ``spread_changed`` are the decisions (Holm's, from :func:`compare_sessions`); None decides
     on this axis alone at 1 − ``confidence``. ``places``: decimals of the shifts in the
     sentence."""
-    import numpy as np
-    from scipy import stats
+    from scipy import stats  # on first use: see README, Development
 
     x = np.asarray(a, dtype=float)
     y = np.asarray(b, dtype=float)
@@ -205,8 +206,7 @@ def compare_axis(
 def hotelling_t2(a: Any, b: Any) -> Hotelling | None:
     """The two-sample Hotelling T² of the means of ``a`` and ``b`` (rows: readings, columns:
     x, y, z); None when there are too few readings or the pooled covariance is singular."""
-    import numpy as np
-    from scipy import stats
+    from scipy import stats  # on first use: see README, Development
 
     x = np.asarray(a, dtype=float)
     y = np.asarray(b, dtype=float)
@@ -272,8 +272,6 @@ def compare_sessions(
     """Compare the session files ``path_a`` (before) and ``path_b`` (after): refused with a
     sentence when they follow different procedures, record different units, or one has
     nothing to analyse."""
-    import numpy as np
-
     first, second = analyse_session(path_a), analyse_session(path_b)
     sa, sb = first.session, second.session
     if sa.procedure_id != sb.procedure_id:

@@ -18,6 +18,8 @@ from datetime import datetime, timedelta
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from station.errors import StationError
 from station.record.baseline import baseline_for
 from station.record.content import parse_time
@@ -138,8 +140,7 @@ def wear_trend(
 ) -> tuple[float, float, float, float, float] | None:
     """The least-squares slope of ``means`` against ``days``: (slope, ci_low, ci_high,
     p_value, intercept); None with fewer than three sessions or all on one day."""
-    import numpy as np
-    from scipy import stats
+    from scipy import stats  # on first use: see README, Development
 
     x = np.asarray(days, dtype=float)
     y = np.asarray(means, dtype=float)

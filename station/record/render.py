@@ -13,7 +13,11 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+from jinja2 import Environment, PackageLoader, StrictUndefined
+from markupsafe import Markup
+
 from station.errors import StationError
+from station.record.charts import report_charts
 from station.record.content import ReportContent, build_content
 from station.record.source import AnalysedSession, analyse_session
 from station.record.text import markdown_text, plain
@@ -29,9 +33,6 @@ class _Trusted(str):
 
 @cache
 def _environment(fmt: str) -> Any:
-    from jinja2 import Environment, PackageLoader, StrictUndefined
-    from markupsafe import Markup
-
     def finalize(value: Any) -> Any:
         if isinstance(value, Markup):
             return value
@@ -65,8 +66,6 @@ def render_content(
         raise StationError(f"unknown report format {fmt!r}; choose one of {', '.join(FORMATS)}.")
     charts = []
     if fmt == "html" and analysed is not None:
-        from station.record.charts import report_charts
-
         charts = [
             {"key": c.key, "title": c.title, "svg": _Trusted(c.svg)}
             for c in report_charts(analysed)

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
-from station.text import format_value
+from station.text import format_figure, format_value
 
 if TYPE_CHECKING:
     from station.procedures import InputField, Step
@@ -143,12 +143,14 @@ class CycleRecord:
     times: Mapping[str, float] | None = None
     """Each channel's reading time (``t_wall``), for the drift's trend; None when unknown."""
 
-    def line(self) -> str:
+    def line(self, *, figures: bool = False) -> str:
         """The one-line form ``cycle 7 x=+0.0012 y=-0.0003 z=+0.0001`` (values at the
-        resolution's decimals)."""
+        resolution's decimals, as the gauge shows them); ``figures=True`` writes them at the
+        figures' decimals instead (``x=+0.00120``), for a screen that shows statistics beside
+        them in that one format."""
+        write = format_figure if figures else format_value
         return f"cycle {self.cycle} " + " ".join(
-            f"{channel}={format_value(value, self.resolution)}"
-            for channel, value in self.values.items()
+            f"{channel}={write(value, self.resolution)}" for channel, value in self.values.items()
         )
 
 

@@ -18,12 +18,13 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from station.analysis.monitor import ReadingSet, Rejection
+from station.analysis.rules import rule_name
 from station.errors import StationError
 from station.plain import plain
 from station.procedures import DEFAULT_CAUSES, OTHER_CAUSE
 
 if TYPE_CHECKING:
-    from station.analysis.monitor import ReadingSet, Rejection
     from station.session.model import Session
 
 
@@ -132,8 +133,6 @@ def acknowledgement(event: Any) -> Acknowledgement:
 
 def recorded_alarm(event: Any, acks: Sequence[Acknowledgement] = ()) -> RecordedAlarm:
     """One ``alarm`` event (a journal line's mapping) with the acknowledgements naming it."""
-    from station.analysis.rules import rule_name
-
     rule = str(event.get("rule") or "")
     return RecordedAlarm(
         seq=int(event["seq"]),
@@ -159,8 +158,6 @@ def recorded_alarms(session: Session) -> tuple[RecordedAlarm, ...]:
 
 def live_events(session: Session) -> list[ReadingSet | Rejection]:
     """The session's readings and rejections in journal order, as the live analysis saw them."""
-    from station.analysis.monitor import ReadingSet, Rejection
-
     events: list[ReadingSet | Rejection] = []
     for event in session.events:
         if event["type"] == "reading":

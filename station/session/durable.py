@@ -16,6 +16,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TextIO, TypeVar
 
+from station.errors import StationError
+
 T = TypeVar("T")
 
 
@@ -59,13 +61,14 @@ def replace_durably(
     *,
     overwrite: bool = True,
     not_over: Path | None = None,
+    mode: int = 0o640,
 ) -> T:
     """Write a text file in full, or not at all, without following a planted link.
 
     ``write(handle)`` fills a private temporary file created beside ``path`` (``O_EXCL`` with an
-    unpredictable name, mode 0640, never through a symlink), which is synced, renamed over
-    ``path`` (a rename replaces a link at ``path`` itself, never its target), and the folder
-    synced. Returns what ``write`` returned.
+    unpredictable name, ``mode`` 0640 unless given, never through a symlink), which is synced,
+    renamed over ``path`` (a rename replaces a link at ``path`` itself, never its target), and
+    the folder synced. Returns what ``write`` returned.
 
     Refused with a StationError, before anything is written: ``path`` is a symbolic link or not
     a regular file, ``path`` exists and ``overwrite`` is False, or ``path`` is the same file as
@@ -74,7 +77,7 @@ def replace_durably(
     """
     path = Path(path)
     check_output_path(path, overwrite=overwrite, not_over=not_over)
-    fd, partial = _private_temporary(path)
+    fd, partial = _private_temporary(path, mode)
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
             result = write(handle)
@@ -92,17 +95,22 @@ def replace_durably(
 
 
 def write_text_durably(
-    path: Path, text: str, *, overwrite: bool = True, not_over: Path | None = None
+    path: Path,
+    text: str,
+    *,
+    overwrite: bool = True,
+    not_over: Path | None = None,
+    mode: int = 0o640,
 ) -> None:
     """:func:`replace_durably` for a whole string."""
-    replace_durably(path, lambda handle: handle.write(text), overwrite=overwrite, not_over=not_over)
+    replace_durably(
+        path, lambda handle: handle.write(text), overwrite=overwrite, not_over=not_over, mode=mode
+    )
 
 
 def check_output_path(path: Path, *, overwrite: bool = True, not_over: Path | None = None) -> None:
     """StationError when ``path`` may not be written: a symbolic link, not a regular file, an
     existing file without ``overwrite``, or the same file as ``not_over``."""
-    from station.errors import StationError
-
     try:
         info = os.lstat(path)
     except FileNotFoundError:
@@ -127,12 +135,12 @@ def check_output_path(path: Path, *, overwrite: bool = True, not_over: Path | No
         raise StationError(f"{path} exists; pass --force to overwrite it or choose another name")
 
 
-def _private_temporary(path: Path) -> tuple[int, str]:
+def _private_temporary(path: Path, mode: int) -> tuple[int, str]:
     """A new file beside ``path`` with an unpredictable name: ``O_EXCL | O_NOFOLLOW``."""
     for _ in range(100):
         name = path.with_name(f".{path.name[:200]}.{secrets.token_hex(8)}.partial")
         try:
-            fd = os.open(name, _NEW_FILE_FLAGS, 0o640)
+            fd = os.open(name, _NEW_FILE_FLAGS, mode)
         except FileExistsError:
             continue
         return fd, str(name)

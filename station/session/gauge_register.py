@@ -32,7 +32,6 @@ import errno
 import fcntl
 import json
 import os
-import secrets
 import textwrap
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
@@ -40,7 +39,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from station.errors import StationError
-from station.session.durable import fsync_folder, make_folders
+from station.session.durable import make_folders, write_text_durably
 
 if TYPE_CHECKING:
     from station.analysis.gauge_check import GaugeCheck
@@ -123,19 +122,8 @@ def _locked(path: Path) -> Iterator[None]:
 
 
 def _write(path: Path, content: Mapping[str, Any]) -> None:
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
     text = json.dumps(content, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
-    descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644)
-    try:
-        with os.fdopen(descriptor, "w", encoding="utf-8") as stream:
-            stream.write(text)
-            stream.flush()
-            os.fsync(stream.fileno())
-        os.replace(temporary, path)
-    except BaseException:
-        temporary.unlink(missing_ok=True)
-        raise
-    fsync_folder(path.parent)
+    write_text_durably(path, text, mode=0o644)
 
 
 def _gauge_key(gauge: str) -> str:

@@ -4,7 +4,7 @@
 sanitised name that cannot leave the folder), appends one JSON line per event with ``seq``,
 ``t``, ``type``, ``prev`` and the line's own ``hash`` (the format is in
 :mod:`station.session.model` and ``sessions/README.md``) and returns only once ``os.fsync`` has
-returned. Each event is checked by the same :class:`~station.session.model.Replay` the loader
+returned. Each event is checked by the same :class:`~station.session.replay.Replay` the loader
 uses before it is written, so a file the writer produced always loads.
 
 While a writer is open it holds an exclusive ``flock`` on the file: a second writer (another
@@ -40,27 +40,15 @@ import uuid
 from collections.abc import Mapping
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, NoReturn
+from typing import Any, NoReturn
 
 from station.errors import StationError
 from station.inputfiles import check_regular_file
 from station.session.durable import fsync_folder, make_folders
-from station.session.model import (
-    FORMAT,
-    HEADER_REQUIRED,
-    RESERVED_FIELDS,
-    Replay,
-    Session,
-    decode_line,
-    encode_line,
-    load_session,
-    read_session_bytes,
-    replay_bytes,
-)
+from station.session.lines import FORMAT, decode_line, encode_line
+from station.session.model import Session, load_session, read_session_bytes, replay_bytes
+from station.session.replay import HEADER_REQUIRED, RESERVED_FIELDS, Replay
 from station.session.signing import finish_message, station_key
-
-if TYPE_CHECKING:
-    pass
 
 _NAME_LIMIT = 40
 _UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
@@ -240,7 +228,7 @@ class SessionWriter:
         except BaseException:
             _close_quietly(fd)
             raise
-        session = replay.freeze(path, lines, recovered.torn)
+        session = Session.from_replay(replay, path, lines, recovered.torn)
         if session.finished:
             _close_quietly(fd)
             raise StationError(
@@ -276,7 +264,7 @@ class SessionWriter:
     def snapshot(self) -> Session:
         """The session as written so far (no file access)."""
         with self._lock:
-            return self._replay.freeze(self.path, self._replay.last_seq + 1, None)
+            return Session.from_replay(self._replay, self.path, self._replay.last_seq + 1, None)
 
     def append(self, type: str, **fields: Any) -> dict[str, Any]:
         """Write one event and fsync it; return the event as stored (with seq, t, prev, hash).

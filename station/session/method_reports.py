@@ -16,7 +16,11 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from station.errors import StationError
+from station.session.gauge_register import record_check, register_path
+from station.session.tables import require_columns
 
 if TYPE_CHECKING:
     from station.analysis.gain_schedule import GainSchedule
@@ -46,8 +50,6 @@ def record_gauge_check(
     typed at its input step, dated by the session's creation (its calibration due date too,
     when typed; ``port``: the line and device channel the gauge was read on). Returns the
     entry; StationError without a gauge id."""
-    from station.session.gauge_register import record_check, register_path
-
     values = _input_values(session, "reference", "tolerance")
     gauge = str(values.get("gauge") or "").strip()
     if not gauge:
@@ -67,10 +69,6 @@ def record_gauge_check(
 def table_joint_inputs(table: Any) -> tuple[Any, dict[str, Any], dict[int, float] | None]:
     """Joint labels, readings x, y, z and lever arms (an optional ``lever`` column, one value
     per joint) of a CSV with columns ``joint,x,y,z[,lever]``."""
-    import numpy as np
-
-    from station.session.tables import require_columns
-
     columns = require_columns(table, JOINT_COLUMNS, "a per-joint table")
     readings = {axis: columns[axis] for axis in ("x", "y", "z")}
     if "lever" not in {name.lower() for name in table.channels}:

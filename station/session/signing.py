@@ -26,6 +26,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from cryptography.exceptions import InvalidSignature
+from cryptography.hazmat.primitives import serialization
+from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey, Ed25519PublicKey
+
 from station.errors import StationError
 
 KEY_FILE_NAME = "signing-key.pem"
@@ -79,9 +83,6 @@ def finish_message(session_id: str, prev: str, seq: int) -> bytes:
 def station_key(create: bool = True) -> StationKey | None:
     """The station's key, made on first use when ``create`` (None when it does not exist and
     ``create`` is False). StationError when the key file cannot be read or made."""
-    from cryptography.hazmat.primitives import serialization
-    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
-
     path = config_folder() / KEY_FILE_NAME
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
@@ -112,9 +113,6 @@ def station_key(create: bool = True) -> StationKey | None:
 
 
 def _make_key(path: Path) -> StationKey:
-    from cryptography.hazmat.primitives import serialization
-    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
-
     private = Ed25519PrivateKey.generate()
     pem = private.private_bytes(
         serialization.Encoding.PEM,
@@ -149,8 +147,6 @@ def _make_key(path: Path) -> StationKey:
 
 
 def _raw_public(private: Any) -> bytes:
-    from cryptography.hazmat.primitives import serialization
-
     return private.public_key().public_bytes(
         serialization.Encoding.Raw, serialization.PublicFormat.Raw
     )
@@ -170,9 +166,6 @@ def check_finish_signature(header: Mapping[str, Any], finish: Mapping[str, Any])
     """Check ``finish`` (a finish event as stored, with its ``prev`` and ``seq``) against the
     header's ``signer``. A header without ``signer`` (a session made before signing) is ok
     with a message saying the finish is unsigned."""
-    from cryptography.exceptions import InvalidSignature
-    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PublicKey
-
     signer = header.get("signer")
     if signer is None:
         return SignatureCheck(True, "", "unsigned (the session predates signing)")

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from station.errors import StationError
-from station.session.model import Status, load_session
+from station.session.model import load_session
+from station.session.replay import Status
 
 SESSIONS_ENV = "STATION_SESSIONS"
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import csv
 import re
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -25,6 +26,7 @@ from station.errors import StationError
 from station.inputfiles import check_regular_file
 from station.plain import plain
 from station.session.model import event_seconds
+from station.session.replay import CYCLE_LIMIT, READING_LIMIT
 
 #: Column names (compared case-insensitively) that index the rows instead of holding readings.
 INDEX_COLUMNS: frozenset[str] = frozenset({"cycle", "subgroup", "t"})
@@ -70,11 +72,6 @@ EXPORT_COMMENT_SCAN_LIMIT = 64 << 20
 """Files up to this size are scanned for the ``# rejected cycle N`` lines a wide export writes
 after its rows (a larger file is raw data, not an export)."""
 
-READING_LIMIT = 1e150
-"""The largest magnitude a reading may have: squares and sums of ten million of them stay
-finite floats (a 1e308 would overflow the mean and sigma into nonsense)."""
-CYCLE_LIMIT = 2**53
-"""Cycle numbers stay exact as floats and fit every integer array."""
 CSV_FILE_LIMIT = 8 << 30
 """The largest CSV file read (8 GiB, some 500 million one-column rows)."""
 HEADER_LINE_LIMIT = 1 << 20
@@ -275,8 +272,6 @@ def _read_tidy(
 
 
 def _load_rows(lines: Any, columns: int) -> np.ndarray:
-    import warnings
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # "input contained no data" for a header-only file
         data = np.loadtxt(

@@ -13,10 +13,12 @@ from __future__ import annotations
 
 import os
 import textwrap
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
-from station.session.model import SessionFileError, line_hash, read_session_bytes, replay_bytes
+from station.session.lines import SessionFileError, decode_line, line_hash
+from station.session.model import read_session_bytes, replay_bytes
+from station.session.signing import check_finish_signature, station_key
 
 _WIDTH = 79
 
@@ -118,11 +120,6 @@ def _verify_chain(path: Path, data: bytes) -> VerifyResult:
 
 def _verify_end(result: VerifyResult, data: bytes, anchor: str | None) -> VerifyResult:
     """The signature of a finished session, the anchor, and what the verdict cannot show."""
-    from dataclasses import replace
-
-    from station.session.model import decode_line
-    from station.session.signing import check_finish_signature, station_key
-
     lines = data.split(b"\n")[:-1]
     header = decode_line(lines[0])
     last = decode_line(lines[-1])

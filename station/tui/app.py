@@ -11,8 +11,8 @@ SIGHUP and SIGTERM (an SSH drop, a shutdown) interrupt the runner, which writes 
 the session file, then the app exits and restores the terminal; the next ``station`` offers to
 resume the session. Textual installs no handler for these itself.
 
-Only the home screen is imported at start; the other screens (and numpy, scipy behind the
-analysis) load when first needed, so the first screen appears fast.
+Only the home screen and the dialogs are imported at start; the other screens (and numpy, scipy
+behind the analysis) load when first needed, so the first screen appears fast.
 """
 
 from __future__ import annotations
@@ -28,19 +28,26 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from textual import events, work
-from textual.app import App
+from textual.app import App, SystemCommand
 from textual.binding import Binding
 from textual.geometry import Size
+from textual.screen import ModalScreen, Screen
 
 from station.errors import StationError
 from station.plain import plain
+from station.tui.autopilot import run_autopilot
 from station.tui.messages import RunnerChanged
 from station.tui.remedies import explained
+from station.tui.screens.dialogs import ConfirmScreen, HelpScreen, QuitQuestion, screen_keys
+from station.tui.screens.home import HomeScreen
+from station.tui.theme import HIGH_CONTRAST_THEME, apply_palette, wanted_theme
+from station.tui.widgets.too_small import TooSmallNotice, too_small
 
+# Deliberately imported where first used, for start-up time (README, Development): the other
+# screens when first shown, the procedure catalogue when first asked for (about 60 ms), and the
+# engine (station.run), which loads numpy, when a session starts; numpy and scipy themselves load
+# on a worker thread (warm_up_analysis). So the home screen appears at once.
 if TYPE_CHECKING:
-    from textual.app import SystemCommand
-    from textual.screen import Screen
-
     from station.procedures import ProcedureCatalog
     from station.run import Runner, RunnerNotice, RunnerState, SessionSetup
 
@@ -105,8 +112,6 @@ class StationApp(App[int]):
 
     def __init__(self, config: StationConfig) -> None:
         super().__init__()
-        from station.tui.theme import HIGH_CONTRAST_THEME, apply_palette, wanted_theme
-
         self.config = config
         # Verdicts and alarms by text attributes; without colour they name no colour at all.
         self.register_theme(HIGH_CONTRAST_THEME)
@@ -152,13 +157,9 @@ class StationApp(App[int]):
                 self._signals_installed.append(signum)
             except (NotImplementedError, RuntimeError, ValueError):
                 pass  # not the main thread (some test harnesses): nothing to restore then
-        from station.tui.screens.home import HomeScreen
-
         self.screen_change_signal.subscribe(self, lambda _screen: self.fit_to_terminal())
         self.push_screen(HomeScreen())
         if self.config.autopilot:
-            from station.tui.autopilot import run_autopilot
-
             self.run_worker(run_autopilot(self), group="autopilot", exclusive=True)
 
     def on_resize(self, event: events.Resize) -> None:
@@ -169,8 +170,6 @@ class StationApp(App[int]):
     def fit_to_terminal(self, size: Size | None = None) -> None:
         """Below the smallest size the screens are laid out for, the current screen shows one
         sentence (``TooSmallNotice``) instead of tables that lost their names and values."""
-        from station.tui.widgets.too_small import TooSmallNotice, too_small
-
         size = size or self.size
         small = too_small(size)
         if small != self.has_class("-too-small"):
@@ -229,10 +228,6 @@ class StationApp(App[int]):
         """Ctrl+C: leave an unfinished session resumable, then quit. Inside a dialog (a note
         being typed, a question) it asks first, naming any half-typed text, so a stray Ctrl+C
         does not throw the text away; a second Ctrl+C on that question quits."""
-        from textual.screen import ModalScreen
-
-        from station.tui.screens.dialogs import ConfirmScreen, QuitQuestion
-
         screen = self.screen
         if isinstance(screen, QuitQuestion):
             self._quit_now()
@@ -268,10 +263,6 @@ class StationApp(App[int]):
         """The command palette (Ctrl+P): every action of the current screen by name, with its
         key, and this screen's keys. Textual's own entries (quit without writing
         ``interrupted``, screenshots) are left out on purpose."""
-        from textual.app import SystemCommand
-
-        from station.tui.screens.dialogs import screen_keys
-
         seen: set[str] = set()
         for active in screen.active_bindings.values():
             binding = active.binding
@@ -294,8 +285,6 @@ class StationApp(App[int]):
 
     def action_keys(self) -> None:
         """``?``: the keys of the current screen (and the help)."""
-        from station.tui.screens.dialogs import HelpScreen
-
         if not isinstance(self.screen, HelpScreen):
             self.push_screen(HelpScreen())
 
@@ -313,7 +302,7 @@ class StationApp(App[int]):
     def catalog(self) -> ProcedureCatalog:
         """The installed procedures (built-in plus ``--procedures`` folders), loaded once."""
         if self._catalog is None:
-            from station.procedures import discover_procedures
+            from station.procedures import discover_procedures  # deferred: start-up time
 
             self._catalog = discover_procedures(self.config.procedure_dirs)
         return self._catalog
@@ -345,7 +334,7 @@ class StationApp(App[int]):
 
     def start_session(self, setup: SessionSetup) -> None:
         """Open the instruments and start a new session; raises StationError with a sentence."""
-        from station.run import Runner
+        from station.run import Runner  # deferred: the engine loads numpy
 
         self.warm_up_analysis()
         self._find_demo_fixture(setup)
@@ -363,7 +352,7 @@ class StationApp(App[int]):
     def _open_instruments(self, setup: SessionSetup) -> None:
         """Open the gauges and wait for the line, so a wrong port is refused before a session
         file exists (PortNotOpen with the reader's own sentence)."""
-        from station.run import open_gauges
+        from station.run import open_gauges  # deferred: the engine loads numpy
 
         self.close_instruments()
         self.gauges = open_gauges(setup)
@@ -397,7 +386,7 @@ class StationApp(App[int]):
     def resume_session(self, path: Path, ports: Any) -> None:
         """Reopen the instruments (``ports``: the line as the set-up screen now says) and
         continue an unfinished session file."""
-        from station.run import Runner, resume_setup
+        from station.run import Runner, resume_setup  # deferred: the engine loads numpy
 
         setup = resume_setup(path, procedures_dirs=self.config.procedure_dirs, ports=ports)
         self.warm_up_analysis()
@@ -425,7 +414,7 @@ class StationApp(App[int]):
 
     @work(thread=True, group="finish", exit_on_error=False)
     def _finish_in_thread(self, runner: Runner) -> None:
-        from station.tui.screens.summary import SummaryView
+        from station.tui.screens.summary import SummaryView  # deferred: a screen loads when shown
 
         try:
             analysis = runner.finish()
@@ -440,7 +429,7 @@ class StationApp(App[int]):
         self.notify(sentence, severity="error", markup=False)
 
     def _show_summary(self, view: Any) -> None:
-        from station.tui.screens.summary import SummaryScreen
+        from station.tui.screens.summary import SummaryScreen  # deferred: a screen loads when shown
 
         self._finishing = False
         self.close_instruments()
@@ -565,6 +554,7 @@ class StationApp(App[int]):
 
     def _show_runner_screen(self, state: RunnerState) -> bool:
         """Put up the checklist or the dashboard for the current step; True when it switched."""
+        # Deferred: a screen loads when first shown.
         from station.tui.screens.checklist import ChecklistScreen
         from station.tui.screens.dashboard import DashboardScreen
 
@@ -573,7 +563,7 @@ class StationApp(App[int]):
         screen = self._run_screen()
         action = state.action.kind
         if action == "stream":
-            from station.tui.screens.strokes import StrokeDashboardScreen
+            from station.tui.screens.strokes import StrokeDashboardScreen  # deferred: as above
 
             if not isinstance(screen, StrokeDashboardScreen):
                 self._replace_run_screen(StrokeDashboardScreen())
@@ -595,9 +585,7 @@ class StationApp(App[int]):
     def _run_screen(self) -> Any:
         """The screen the session runs on, under any dialog or the alarm list opened over it
         (those stay open while the run screen is still the right one)."""
-        from textual.screen import ModalScreen
-
-        from station.tui.screens.alarms import AlarmsScreen
+        from station.tui.screens.alarms import AlarmsScreen  # deferred: loads when shown
 
         for screen in reversed(self.screen_stack):
             if not isinstance(screen, ModalScreen | AlarmsScreen):
@@ -606,9 +594,7 @@ class StationApp(App[int]):
 
     def _replace_run_screen(self, screen: Any) -> None:
         """Swap the set-up, checklist or dashboard for ``screen`` (modals are closed first)."""
-        from textual.screen import ModalScreen
-
-        from station.tui.screens.alarms import AlarmsScreen
+        from station.tui.screens.alarms import AlarmsScreen  # deferred: loads when shown
 
         while isinstance(self.screen, ModalScreen | AlarmsScreen):
             self.pop_screen()
@@ -616,8 +602,6 @@ class StationApp(App[int]):
 
     def go_home(self) -> None:
         """Back to a fresh home screen (after a summary or a review)."""
-        from station.tui.screens.home import HomeScreen
-
         self.runner = None
         with self._state_lock:
             self._latest_state = None

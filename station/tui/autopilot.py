@@ -13,6 +13,8 @@ from __future__ import annotations
 import asyncio
 from typing import TYPE_CHECKING
 
+from textual.widgets import Input
+
 if TYPE_CHECKING:
     from station.tui.app import StationApp
 
@@ -24,6 +26,7 @@ STEP_PAUSES = 5
 
 async def run_autopilot(app: StationApp) -> None:
     """Drive the screens until the summary is up (or the app exits)."""
+    # Deferred: the screens load when first shown (and the set-up imports the app).
     from station.tui.screens.checklist import ChecklistScreen
     from station.tui.screens.dashboard import DashboardScreen
     from station.tui.screens.home import HomeScreen
@@ -89,7 +92,6 @@ async def run_autopilot(app: StationApp) -> None:
 def _fill_inputs(app: StationApp, screen: object) -> None:
     """Type into the empty input fields what the simulated teach pendant shows (X, Y, Z into
     the fields named x, y, z), else a demo value."""
-    from textual.widgets import Input
 
     state = app.current_state()
     fixture = app.demo_fixture

@@ -6,11 +6,13 @@ reader); nothing here parses a frame or writes a file.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from station.errors import StationError
+from station.text import format_value
 
 DEMO_PROTOCOL = "mitutoyo"
 DEMO_CHANNEL_MAP = {"1": "x", "2": "y", "3": "z"}
@@ -18,6 +20,9 @@ BAR_CHANNEL_MAP = {"1": "h", "2": "v", "3": "s"}
 BAR_PUSH_RATE = 200.0
 """Sets a second the simulated bar's indicators and scale send (a linear-scale counter's rate)."""
 TEST_CAPTURES = 5
+REST_START_SLACK = 0.05
+"""A zero may begin this part of a period after the simulated robot came to rest (its dwell
+is 0.35 of the period; the zero needs its settle time of stillness within it)."""
 
 DEMO_PROCEDURES = {
     "repeatability": "three dial indicators in one fixture",
@@ -53,6 +58,22 @@ class DemoFixture:
         if placement is not None and hasattr(model, "placement_of"):
             model.placement = placement
 
+    def wait_at_rest(self) -> None:
+        """Block until the simulated robot has just come to rest at the fixture, as a
+        technician stops a real robot there before zeroing (a zero taken while it is away
+        would zero the indicators at their free travel, and every later cycle would be taken
+        away from the fixture); at once when the simulated robot does not move. At most one
+        period; call it from a worker thread."""
+        motion = getattr(self.simulator, "motion", None)
+        if motion is None:
+            return
+        now = time.monotonic() - self.simulator.motion_t0
+        start, _ = motion.rest_window(int(now // motion.period))
+        if now - start > REST_START_SLACK * motion.period:
+            start, _ = motion.rest_window(int(now // motion.period) + 1)
+        if start > now:
+            time.sleep(start - now)
+
     def stop(self) -> None:
         """Close the pseudo-terminal and stop the simulator's thread."""
         self.simulator.stop()
@@ -84,6 +105,7 @@ def start_demo_fixture(
     set-up takes the ``arrival`` trigger: the station counts the robot's round trips. Without
     it every poll is a new rest position (Space per cycle).
     """
+    # Deferred: the gauge layer (about 80 ms) loads when a line is opened, off the start path.
     from station.instruments.motion import CycleMotion, default_free_travel
     from station.instruments.protocols import get_protocol
     from station.instruments.simulator import (
@@ -185,7 +207,7 @@ class DemoLab:
 
 def gauge_set(ports: Sequence[Any], trigger: str, **options: Any) -> Any:
     """A started-not GaugeSet over the runner's ``PortSetup``s (protocols from the registry)."""
-    from station.instruments.gauge import GaugeSet, PortSpec
+    from station.instruments.gauge import GaugeSet, PortSpec  # deferred: as above
     from station.instruments.protocols import get_protocol
 
     specs = [
@@ -217,8 +239,7 @@ def test_connection(
     Nothing is recorded. Raises StationError when the port cannot be opened or stays silent,
     or when the frames disagree with the unit and resolution (naming both).
     """
-    from station.instruments.units import describe_inference
-    from station.text import format_value
+    from station.instruments.units import describe_inference  # deferred: as above
 
     # Arrival waits for the robot: the test polls (a push device is polled too, where it can).
     gauges = gauge_set(ports, "poll" if trigger in ("push", "arrival") else trigger)

@@ -7,8 +7,8 @@ underline) and, without colour, name no colour at all, so they take the theme's 
 which keeps its contrast. ``STATION_THEME=high-contrast`` picks a black-and-white theme with the
 same attributes for a washed-out screen in a bright workshop.
 
-Front ends import ``VERDICT_STYLES`` and ``ALARM_STYLES`` from here (``figures`` re-exports the
-former); :func:`apply_palette` fills them in place when the app starts, so every screen agrees.
+Front ends import ``VERDICT_STYLES`` and ``ALARM_STYLES`` from here; :func:`apply_palette`
+fills them in place when the app starts, so every screen agrees.
 """
 
 from __future__ import annotations

@@ -73,7 +73,7 @@ def test_an_offset_the_zero_explains_is_said_to_be_the_zeros():
     # (2u) is no evidence against the robot (the issue's one-reading zero of -0.0010).
     values = noise() + 0.0002
     (hint,) = [h for h in hints(values, zero_uncertainty={"x": 0.00015}) if "off nominal" in h]
-    assert "within what the zero's own uncertainty (±0.0003 in) explains" in hint
+    assert "within what the zero's own uncertainty (±0.00030 in) explains" in hint
     assert "zero again from more readings" in hint
     assert "inverse kinematics" not in hint
 
@@ -81,5 +81,6 @@ def test_an_offset_the_zero_explains_is_said_to_be_the_zeros():
 def test_an_offset_beyond_the_zeros_uncertainty_still_points_at_the_robot():
     values = noise() + 0.0004
     (hint,) = [h for h in hints(values, zero_uncertainty={"x": 0.00003}) if "off nominal" in h]
-    assert "beyond the zero's own uncertainty (±6e-05 in)" in hint
+    # At the figures' decimals like the average beside it, never in scientific notation.
+    assert "beyond the zero's own uncertainty (±0.00006 in)" in hint
     assert "inverse kinematics" in hint

@@ -42,7 +42,7 @@ def test_table_2_1_report_shows_the_reports_figures(table_2_1):
         "NOMINAL: +0.00000",
         "LOWER SPEC: -0.00100",
         "TOTAL NUMBER OF PIECES: 30",
-        "SIGMA: +0.00026",
+        "SIGMA: 0.00026",  # a spread has no sign
         "RANGE: 0.00120",
         "MODE: +0.00020",
         "SKEWNESS a1: -0.356",

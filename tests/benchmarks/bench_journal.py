@@ -20,7 +20,8 @@ from pathlib import Path
 from station.procedures import discover_procedures
 from station.run import PortSetup, SessionSetup
 from station.session.journal import SessionWriter
-from station.session.model import decode_line, encode_line, load_session
+from station.session.lines import decode_line, encode_line
+from station.session.model import load_session
 
 
 def reading(cycle: int) -> dict:

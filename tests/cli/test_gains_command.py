@@ -93,15 +93,16 @@ def test_c_header_compiles_and_evaluates(gains_csv: Path, tmp_path: Path):
 def test_c_header_never_overwrites_its_input_nor_follows_a_symlink(gains_csv: Path, tmp_path: Path):
     before = gains_csv.read_bytes()
     result = station(gains_csv, "--c", gains_csv)
-    assert result.returncode == 2 and "is the input file" in result.stderr
+    assert result.returncode == 2 and "is the input file" in result.stderr, result.stderr
     assert gains_csv.read_bytes() == before
     victim = tmp_path / "victim.txt"
     victim.write_text("keep me")
     link = tmp_path / "out.h"
     link.symlink_to(victim)
-    assert station(gains_csv, "--c", link).returncode == 0
-    assert victim.read_text() == "keep me"  # the link was replaced, not written through
-    assert not link.is_symlink() and "gain_schedule_kp" in link.read_text()
+    refused = station(gains_csv, "--c", link)
+    assert refused.returncode == 2 and "symbolic link" in refused.stderr, refused.stderr
+    assert len(refused.stderr.strip().splitlines()) == 1
+    assert victim.read_text() == "keep me" and link.is_symlink()  # nothing written through it
 
 
 @pytest.mark.parametrize(

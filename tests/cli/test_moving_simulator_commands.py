@@ -3,26 +3,18 @@
 from __future__ import annotations
 
 import json
-import signal
 import subprocess
-import sys
 
 import pytest
+from helpers import STATION, start_simulator, stop_simulator
 
 from station.instruments.simulator import AxisModel, FixtureModel, GaugeSpec
 
-STATION = [sys.executable, "-m", "station"]
-
 
 def test_read_prints_one_set_per_round_trip_and_what_the_frames_say() -> None:
-    simulator = subprocess.Popen(
-        [*STATION, "simulate", "--protocol", "mitutoyo", "--cycle-period", "0.5"]
-        + ["--noise", "0.01", "--seed", "9"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
+    simulator, url = start_simulator(
+        "--protocol", "mitutoyo", "--cycle-period", "0.5", "--noise", "0.01", "--seed", "9"
     )
-    url = simulator.stdout.readline().strip()
     try:
         result = subprocess.run(
             [*STATION, "read", "--port", url, "--protocol", "mitutoyo", "--map", "1=x,2=y,3=z"]
@@ -33,8 +25,7 @@ def test_read_prints_one_set_per_round_trip_and_what_the_frames_say() -> None:
             timeout=30,
         )
     finally:
-        simulator.send_signal(signal.SIGTERM)
-        _, simulator_err = simulator.communicate(timeout=10)
+        simulator_err = stop_simulator(simulator)
     assert result.returncode == 0, result.stderr
     assert "returns every 0.5 s" in simulator_err
     lines = [json.loads(line) for line in result.stdout.splitlines()]

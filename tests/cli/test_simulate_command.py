@@ -4,34 +4,17 @@ from __future__ import annotations
 
 import signal
 import subprocess
-import sys
 
 import pytest
+from helpers import STATION, start_simulator, stop_simulator
 
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import AxisModel, FixtureModel, GaugeSpec
 from station.instruments.transport import open_port
 
-STATION = [sys.executable, "-m", "station"]
-
-
-def start(*args: str) -> tuple[subprocess.Popen, str]:
-    process = subprocess.Popen(
-        [*STATION, "simulate", *args],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    url = process.stdout.readline().strip()
-    if not url:
-        process.kill()
-        pytest.fail(f"no URL: {process.communicate()[1]}")
-    return process, url
-
 
 def finish(process: subprocess.Popen, sig: int) -> tuple[int, str]:
-    process.send_signal(sig)
-    _, err = process.communicate(timeout=10)
+    err = stop_simulator(process, sig)
     return process.returncode, err
 
 
@@ -69,7 +52,7 @@ def test_url_first_then_the_seeded_values_then_a_clean_exit(where: str, sig: int
     ]
     if where == "--tcp":
         args.append("0")
-    process, url = start(*args)
+    process, url = start_simulator(*args)
     try:
         if where == "--pty":
             assert url.startswith("/dev/pts/")
@@ -89,7 +72,7 @@ def test_url_first_then_the_seeded_values_then_a_clean_exit(where: str, sig: int
 
 
 def test_error_rate_one_sends_only_error_frames() -> None:
-    process, url = start("--protocol", "mitutoyo", "--error-rate", "1", "--channels", "x")
+    process, url = start_simulator("--protocol", "mitutoyo", "--error-rate", "1", "--channels", "x")
     try:
         frames = poll(url, "mitutoyo", 2)
     finally:
@@ -142,7 +125,7 @@ def test_link_refuses_to_replace_a_file(tmp_path) -> None:
 def test_link_replaces_a_stale_simulator_link(tmp_path) -> None:
     link = tmp_path / "gauge"
     link.symlink_to("/dev/pts/999999")  # what a killed simulator leaves behind
-    process, url = start("--protocol", "mitutoyo", "--link", str(link))
+    process, url = start_simulator("--protocol", "mitutoyo", "--link", str(link))
     assert url == str(link) and link.resolve() != "/dev/pts/999999"
     assert len(poll(url, "mitutoyo", 1)) == 1
     code, err = finish(process, signal.SIGTERM)
@@ -156,7 +139,7 @@ def test_a_hang_up_cleans_up_like_sigterm(sig: int) -> None:
     of the disconnect link was left behind."""
     from pathlib import Path
 
-    process, url = start("--protocol", "mitutoyo", "--disconnect-every", "30")
+    process, url = start_simulator("--protocol", "mitutoyo", "--disconnect-every", "30")
     folder = Path(url).parent
     assert folder.name.startswith("station-sim-") and folder.is_dir()
     code, err = finish(process, sig)

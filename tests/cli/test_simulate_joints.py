@@ -2,47 +2,35 @@
 
 from __future__ import annotations
 
-import signal
 import subprocess
-import sys
 
 import pytest
+from helpers import STATION, start_simulator, stop_simulator
 
 from station.instruments.joint_model import faulty_arm
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import GaugeSpec
 from station.instruments.transport import open_port
 
-STATION = [sys.executable, "-m", "station"]
-
 
 def test_joints_model_serves_the_faulty_arm_and_names_the_joint_to_move() -> None:
-    process = subprocess.Popen(
-        [
-            *STATION,
-            "simulate",
-            "--protocol",
-            "idh",
-            "--model",
-            "joints",
-            "--faulty-joint",
-            "1",
-            "--joint-fault",
-            "backlash",
-            "--fault-size",
-            "8e-5",
-            "--cycles-per-joint",
-            "4",
-            "--seed",
-            "7",
-        ],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
+    process, url = start_simulator(
+        "--protocol",
+        "idh",
+        "--model",
+        "joints",
+        "--faulty-joint",
+        "1",
+        "--joint-fault",
+        "backlash",
+        "--fault-size",
+        "8e-5",
+        "--cycles-per-joint",
+        "4",
+        "--seed",
+        "7",
     )
     try:
-        url = process.stdout.readline().strip()
-        assert url, process.stderr.read()
         protocol = get_protocol("idh")
         port = open_port(url, protocol.settings, timeout=2.0)
         try:
@@ -53,8 +41,7 @@ def test_joints_model_serves_the_faulty_arm_and_names_the_joint_to_move() -> Non
         finally:
             port.close()
     finally:
-        process.send_signal(signal.SIGTERM)
-        _, err = process.communicate(timeout=10)
+        err = stop_simulator(process)
     arm = faulty_arm(1, "backlash", size=8e-5, cycles=4, gauge=GaugeSpec(0.0001, -0.5, 0.5, "in"))
     assert values == pytest.approx([arm.value("x", k, 7) for k in range(4)], abs=1e-9)
     # Backlash of 8e-5 rad, x seeing 17.9 in per radian of joint 1: x alternates by 0.0014 in.

@@ -100,7 +100,7 @@ def _crafted_session(tmp_path: Path, **header) -> Path:
     sys.path.insert(0, str(REPO / "tests"))
     from session.conftest import reading_fields, session_header_fields
 
-    from station.session.model import encode_line, line_hash
+    from station.session.lines import encode_line, line_hash
 
     fields = {**session_header_fields(), "format": "station-session/1", "session": "s"}
     fields.update(created="2026-11-23T12:00:00Z", host="h", **header)
@@ -138,7 +138,7 @@ def test_a_crafted_huge_cycle_number_does_not_verify(tmp_path: Path) -> None:
     path = _crafted_session(tmp_path)
     data = path.read_bytes().split(b"\n")
     # Rewrite the last reading with cycle 2**63 and a correct chain.
-    from station.session.model import decode_line, encode_line
+    from station.session.lines import decode_line, encode_line
 
     record = decode_line(data[-2])
     record = {k: v for k, v in record.items() if k not in ("prev", "hash")}

@@ -8,13 +8,12 @@ from several readings and infers what its frames say.
 from __future__ import annotations
 
 import re
-import signal
 import subprocess
-import sys
 import threading
 import time
 
 import pytest
+from helpers import start_simulator, stop_simulator
 
 from station.errors import StationError
 from station.instruments.arrival import ArrivalConfig
@@ -23,7 +22,6 @@ from station.instruments.motion import CycleMotion
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import AxisModel, FixtureModel, GaugeSpec, Simulator
 
-STATION = [sys.executable, "-m", "station"]
 PERIOD = 0.5
 SEED = 5
 NOISE = 0.01
@@ -34,33 +32,9 @@ FAST_ARRIVAL = ArrivalConfig(band=0.1, still=2, settle=0.08, timeout=1.0)
 
 def simulate(*extra: str) -> tuple[subprocess.Popen, str]:
     """``station simulate`` (Mitutoyo, x y z in mm at 0.001) as a subprocess; its URL."""
-    process = subprocess.Popen(
-        [
-            *STATION,
-            "simulate",
-            "--protocol",
-            "mitutoyo",
-            "--seed",
-            str(SEED),
-            "--noise",
-            str(NOISE),
-            *extra,
-        ],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
+    return start_simulator(
+        "--protocol", "mitutoyo", "--seed", str(SEED), "--noise", str(NOISE), *extra
     )
-    url = process.stdout.readline().strip()
-    if not url:
-        process.kill()
-        pytest.fail(f"no URL: {process.communicate()[1]}")
-    return process, url
-
-
-def stop(process: subprocess.Popen) -> str:
-    process.send_signal(signal.SIGTERM)
-    _, err = process.communicate(timeout=10)
-    return err
 
 
 def rest_values(cycles: int) -> list[dict[str, float]]:
@@ -107,7 +81,7 @@ def test_arrival_takes_one_set_per_round_trip_at_rest_spaced_by_the_period() -> 
         extra = gauges.wait_set(0.0)
     finally:
         gauges.stop()
-        stop(process)
+        stop_simulator(process)
     assert extra is None  # the robot still at rest after its set: no second set
     values = [{c: r.value for c, r in result.readings.items()} for result, _ in sets]
     # Every set is a rest position, of consecutive cycles: none was taken while the robot was
@@ -140,7 +114,7 @@ def test_a_return_that_hunts_is_reported_and_not_recorded() -> None:
             time.sleep(0.02)
     finally:
         gauges.stop()
-        stop(process)
+        stop_simulator(process)
     assert all(s is not None for s in sets)
     cycles = [cycle_of({c: r.value for c, r in s.readings.items()}) for s in sets]
     # Only the odd cycles settle: every second return hunts on y and is not a set.
@@ -201,7 +175,7 @@ def test_a_moving_robot_cannot_be_zeroed_while_it_travels() -> None:
             gauges.zero(readings=10, settle=0.4, timeout=1.0)
     finally:
         gauges.stop()
-        stop(process)
+        stop_simulator(process)
 
 
 def test_frames_of_a_mm_simulator_refuse_an_inch_session_naming_both() -> None:
@@ -219,7 +193,7 @@ def test_frames_of_a_mm_simulator_refuse_an_inch_session_naming_both() -> None:
         agrees = gauges.check_frames("mm", 0.001, readings=1, timeout=2.0)
     finally:
         gauges.stop()
-        stop(process)
+        stop_simulator(process)
     assert sentence == (
         "the gauges send steps of 0.001, which is mm on this protocol; "
         "the session is in inches at 0.0001"

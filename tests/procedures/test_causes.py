@@ -2,35 +2,13 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
+from helpers import CHECK_STEP as CHECK
+from helpers import PROBE_HEAD as HEAD
+from helpers import write_procedure as write
 
 from station.errors import StationError
 from station.procedures import DEFAULT_CAUSES, load_procedure
-
-HEAD = """
-id = "probe"
-title = "Probe"
-version = "1"
-report_section = "2.6"
-channels = ["x", "y", "z"]
-unit = "in"
-resolution = 0.0001
-"""
-CHECK = """
-[[steps]]
-id = "first"
-kind = "check"
-title = "First"
-text = "Do the first thing."
-"""
-
-
-def write(tmp_path: Path, text: str) -> Path:
-    path = tmp_path / "probe.toml"
-    path.write_text(text)
-    return path
 
 
 def test_a_procedure_without_causes_offers_the_default_list(tmp_path):

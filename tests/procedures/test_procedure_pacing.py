@@ -2,24 +2,16 @@
 
 from __future__ import annotations
 
-import textwrap
 from pathlib import Path
 
 import pytest
+from helpers import PROBE_HEAD as HEAD
+from helpers import write_procedure as write
 
 from station.errors import StationError
 from station.instruments.arrival import ArrivalConfig
 from station.procedures import load_procedure
 
-HEAD = """
-id = "probe"
-title = "Probe"
-version = "1"
-report_section = "2.6"
-channels = ["x", "y", "z"]
-unit = "in"
-resolution = 0.0001
-"""
 ZERO = """
 [[steps]]
 id = "zero"
@@ -27,12 +19,6 @@ kind = "zero"
 title = "Zero"
 text = "Keep the robot still and zero."
 """
-
-
-def write(tmp_path: Path, text: str) -> Path:
-    path = tmp_path / "probe.toml"
-    path.write_text(textwrap.dedent(text))
-    return path
 
 
 def test_without_settings_the_defaults_apply(tmp_path: Path) -> None:

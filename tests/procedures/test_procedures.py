@@ -5,11 +5,13 @@ from __future__ import annotations
 import shutil
 import subprocess
 import sys
-import textwrap
 import zipfile
 from pathlib import Path
 
 import pytest
+from helpers import CHECK_STEP as CHECK
+from helpers import PROBE_HEAD as HEAD
+from helpers import write_procedure as write
 
 from station.errors import StationError
 from station.procedures import (
@@ -19,29 +21,6 @@ from station.procedures import (
 )
 
 REPO = Path(__file__).resolve().parents[2]
-
-HEAD = """
-id = "probe"
-title = "Probe"
-version = "1"
-report_section = "2.6"
-channels = ["x", "y", "z"]
-unit = "in"
-resolution = 0.0001
-"""
-CHECK = """
-[[steps]]
-id = "first"
-kind = "check"
-title = "First"
-text = "Do the first thing."
-"""
-
-
-def write(tmp_path: Path, text: str, name: str = "probe.toml") -> Path:
-    path = tmp_path / name
-    path.write_text(textwrap.dedent(text))
-    return path
 
 
 def test_the_builtin_repeatability_procedure_loads() -> None:

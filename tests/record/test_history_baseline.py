@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import json
+import os
 from datetime import UTC, datetime, timedelta
 
 import pytest
 
 from station.cli import main
+from station.errors import StationError
 from station.record.baseline import baseline_for, baseline_path, clear_baseline, store_baseline
 from station.record.history import robot_history, text_chart
 
@@ -127,3 +129,32 @@ def test_a_damaged_baseline_is_named_not_trusted(sessions, capsys):
     baseline_path("R1").write_text("{not json")
     assert main(["baseline", "R1"]) == 2
     assert "cannot be read" in capsys.readouterr().err
+
+
+def test_a_baseline_is_never_written_through_a_symbolic_link(sessions, tmp_path):
+    filed = write_repeatability(sessions, robot="R1")
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious\n")
+    link = baseline_path("R1")
+    link.parent.mkdir(parents=True, exist_ok=True)
+    link.symlink_to(victim)
+    with pytest.raises(StationError, match="symbolic link"):
+        store_baseline("R1", filed)
+    assert victim.read_text() == "precious\n" and link.is_symlink()
+    assert sorted(p.name for p in link.parent.iterdir()) == [link.name]  # no temporary left
+
+
+def test_a_link_planted_beside_the_baseline_neither_blocks_nor_receives_it(sessions, tmp_path):
+    """The baseline's temporary file has an unpredictable name: a link planted at the name the
+    store once used (``.<file>.<pid>.partial``) is left alone and the baseline is stored."""
+    filed = write_repeatability(sessions, robot="R1")
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious\n")
+    path = baseline_path("R1")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    planted = path.with_name(f".{path.name}.{os.getpid()}.partial")
+    planted.symlink_to(victim)
+    store_baseline("R1", filed)
+    assert baseline_for("R1")["robot"] == "R1"
+    assert path.is_file() and not path.is_symlink()
+    assert victim.read_text() == "precious\n" and planted.is_symlink()

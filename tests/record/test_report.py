@@ -10,6 +10,7 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
+from helpers import start_simulator, stop_simulator
 
 from station.cli import main
 from station.record.content import MISSING, acknowledgement_of, build_content
@@ -245,33 +246,16 @@ def test_report_of_a_real_headless_capture(tmp_path):
     """A session recorded by ``station capture`` against ``station simulate`` (both real
     processes on a real pty) reports the same facts in every format, its port among them."""
     import os
-    import signal
     import sys
 
     station = [sys.executable, "-m", "station"]
     environment = {**os.environ, "STATION_PROCEDURES": ""}
-    simulate = subprocess.Popen(
-        # Inch gauges at the procedure's 0.0001 (the frames are checked against the session).
-        [
-            *station,
-            "simulate",
-            "--protocol",
-            "mitutoyo",
-            "--unit",
-            "in",
-            "--resolution",
-            "0.0001",
-            "--seed",
-            "3",
-        ],  # fmt: skip
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
+    # Inch gauges at the procedure's 0.0001 (the frames are checked against the session).
+    simulate, url = start_simulator(
+        "--protocol", "mitutoyo", "--unit", "in", "--resolution", "0.0001", "--seed", "3",
         env=environment,
-    )
+    )  # fmt: skip
     try:
-        url = simulate.stdout.readline().strip()
-        assert url, simulate.stderr.read()
         capture = subprocess.run(
             [
                 *station, "capture", "--procedure", "repeatability", "--port", url,
@@ -283,8 +267,7 @@ def test_report_of_a_real_headless_capture(tmp_path):
         )  # fmt: skip
         assert capture.returncode == 0, capture.stderr
     finally:
-        simulate.send_signal(signal.SIGTERM)
-        simulate.communicate(timeout=10)
+        stop_simulator(simulate)
     (path,) = (tmp_path / "sessions").glob("*.jsonl")
     content = build_content(analyse_session(path))
     assert content.gauges[0].port == url and len(content.readings) == 25

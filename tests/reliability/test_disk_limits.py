@@ -17,7 +17,7 @@ from station.session.verify import verify_session
 
 from .conftest import Capture, assert_acknowledged_kept, capture_args
 
-CYCLES = 200
+CYCLES = 80
 FILE_LIMIT = 16_000  # bytes: the header, the steps and some twenty cycles
 
 
@@ -58,14 +58,14 @@ def test_file_size_limit_stops_with_one_line(simulators, tmp_path):
 
 @pytest.fixture
 def small_tmpfs(tmp_path):
-    """A 64 KiB tmpfs, or a skip when mounting is not permitted here."""
+    """A 32 KiB tmpfs, or a skip when mounting is not permitted here."""
     mount, umount = shutil.which("mount"), shutil.which("umount")
     if os.geteuid() != 0 or mount is None or umount is None:
         pytest.skip("a full disk needs a small tmpfs: mounting one requires root")
     folder = tmp_path / "full"
     folder.mkdir()
     done = subprocess.run(
-        [mount, "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(folder)],
+        [mount, "-t", "tmpfs", "-o", "size=32k", "tmpfs", str(folder)],
         capture_output=True,
         text=True,
     )

@@ -3,23 +3,11 @@ a refused set, however short ``--timeout`` and ``--attempts`` are."""
 
 from __future__ import annotations
 
+from helpers import CYCLES_ONLY
+
 from station.session.model import load_session
 
 from .conftest import Capture
-
-CYCLES_ONLY = b"""
-id = "cycles-only"
-title = "Cycles without zeroing"
-version = "1"
-report_section = "2.6"
-channels = ["x", "y", "z"]
-unit = "in"
-resolution = 0.0001
-[[steps]]
-id = "cycles"
-kind = "cycles"
-title = "Cycles"
-"""
 
 
 def test_push_waiting_for_data_is_not_a_refusal(simulators, tmp_path):

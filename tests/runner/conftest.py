@@ -7,6 +7,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
+from helpers import CYCLES_ONLY
 
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import AxisModel, Faults, GaugeSpec, Simulator, fixture_model
@@ -147,33 +148,21 @@ title = "Cycles"
 """
 
 
+def written_procedure(path: Path, data: bytes) -> Procedure:
+    """``data`` written as the procedure file ``path`` (a session records the file it ran) and
+    that procedure."""
+    path.write_bytes(data)
+    return parse_procedure(data, path)
+
+
 def every_kind_procedure(folder: Path) -> Procedure:
     """A procedure with check, input, zero, repeat (check + capture) and cycles steps."""
-    path = folder / "every-kind.toml"
-    path.write_bytes(EVERY_KIND)
-    return parse_procedure(EVERY_KIND, path)
-
-
-CYCLES_ONLY = b"""
-id = "cycles-only"
-title = "Cycles without zeroing"
-version = "1"
-report_section = "2.6"
-channels = ["x", "y", "z"]
-unit = "in"
-resolution = 0.0001
-[[steps]]
-id = "cycles"
-kind = "cycles"
-title = "Cycles"
-"""
+    return written_procedure(folder / "every-kind.toml", EVERY_KIND)
 
 
 def cycles_only_procedure(folder: Path) -> Procedure:
     """A procedure that is one cycles step (for tests about reading sets alone)."""
-    path = folder / "cycles-only.toml"
-    path.write_bytes(CYCLES_ONLY)
-    return parse_procedure(CYCLES_ONLY, path)
+    return written_procedure(folder / "cycles-only.toml", CYCLES_ONLY)
 
 
 STROKES = b"""
@@ -197,6 +186,4 @@ target = 2
 
 def strokes_procedure(folder: Path) -> Procedure:
     """A procedure that is one stroke step over channels h, v and s (linearity's shape)."""
-    path = folder / "strokes.toml"
-    path.write_bytes(STROKES)
-    return parse_procedure(STROKES, path)
+    return written_procedure(folder / "strokes.toml", STROKES)

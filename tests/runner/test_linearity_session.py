@@ -8,16 +8,15 @@ import json
 import re
 import signal
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
+from helpers import STATION, start_simulator, stop_simulator
 
 from station.instruments.simulator import BarModel
 from station.session.model import load_session
 
-STATION = [sys.executable, "-m", "station"]
 SEED = 5
 BAR = {"points": 100, "dwell": 6, "bow": 0.0015, "sag": 0.0008, "noise": 0.00002}
 STROKES = 25
@@ -25,35 +24,18 @@ STROKES = 25
 
 def start_bar(*extra: str) -> tuple[subprocess.Popen, str]:
     """``station simulate --model bar`` pushing 500 sets a second; returns it and its URL."""
-    process = subprocess.Popen(
-        [
-            *STATION,
-            "simulate",
-            "--protocol",
-            "mitutoyo",
-            "--model",
-            "bar",
-            "--seed",
-            str(SEED),
-            "--push-rate",
-            "500",
-            *(f"--{key}={value}" for key, value in BAR.items()),
-            *extra,
-        ],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
+    return start_simulator(
+        "--protocol",
+        "mitutoyo",
+        "--model",
+        "bar",
+        "--seed",
+        str(SEED),
+        "--push-rate",
+        "500",
+        *(f"--{key}={value}" for key, value in BAR.items()),
+        *extra,
     )
-    url = process.stdout.readline().strip()
-    if not url:
-        process.kill()
-        pytest.fail(f"the simulator gave no URL: {process.communicate()[1]}")
-    return process, url
-
-
-def stop(process: subprocess.Popen) -> None:
-    process.send_signal(signal.SIGTERM)
-    process.communicate(timeout=10)
 
 
 def capture(url: str, folder: Path, *extra: str) -> subprocess.Popen:
@@ -135,7 +117,7 @@ def test_a_linearity_session_streams_every_point_and_recovers_the_bar(tmp_path: 
         process = capture(url, tmp_path)
         out, err = process.communicate(timeout=60)
     finally:
-        stop(simulator)
+        stop_simulator(simulator)
     assert process.returncode == 0, err
     lines = [line for line in out.splitlines() if line.startswith("stroke ")]
     assert len(lines) == STROKES
@@ -177,7 +159,7 @@ def test_sigterm_mid_stream_then_resume_continues_the_strokes(tmp_path: Path) ->
         resumed = capture(url, tmp_path, "--resume", str(path))
         out, err = resumed.communicate(timeout=60)
     finally:
-        stop(simulator)
+        stop_simulator(simulator)
     assert resumed.returncode == 0, err
     numbers = [int(line.split()[1]) for line in out.splitlines() if line.startswith("stroke ")]
     # The numbering continues after the strokes acknowledged before the signal.
@@ -230,7 +212,7 @@ def test_a_site_copy_of_linearity_under_another_id_gets_the_linearity_report(
         )
         out, err = process.communicate(timeout=60)
     finally:
-        stop(simulator)
+        stop_simulator(simulator)
     assert process.returncode == 0, err
     assert "LINEARITY REPORT" in out
     path = next((tmp_path / "sessions").glob("*.jsonl"))

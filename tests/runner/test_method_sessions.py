@@ -7,32 +7,19 @@ from __future__ import annotations
 import datetime as dt
 import json
 import os
-import signal
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from helpers import STATION, start_simulator, stop_simulator
 
 from station.session.gauge_register import coverage, coverage_lines, load_register
 from station.session.model import load_session
 from station.verdicts import analyze_session_file
 
-STATION = [sys.executable, "-m", "station"]
-
 
 def simulate(*args: str, protocol: str = "idh") -> tuple[subprocess.Popen, str]:
-    process = subprocess.Popen(
-        [*STATION, "simulate", "--protocol", protocol, *args],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    url = process.stdout.readline().strip()
-    if not url:
-        process.kill()
-        pytest.fail(f"the simulator gave no URL: {process.communicate()[1]}")
-    return process, url
+    return start_simulator("--protocol", protocol, *args)
 
 
 def capture(
@@ -117,8 +104,7 @@ def test_gauge_check_session_is_analysed_and_filed(
             protocol=protocol,
         )
     finally:
-        simulator.send_signal(signal.SIGTERM)
-        simulator.communicate(timeout=10)
+        stop_simulator(simulator)
     study = analyze_json(path)["gauge_check"]
     assert study["n"] == 25 and study["capable"] is capable
     # A software zero reads the plate once: that reading's own error (noise, and the display's
@@ -170,8 +156,7 @@ def test_joint_troubleshooting_session_names_the_faulty_joint(tmp_path: Path, pr
             protocol=protocol,
         )
     finally:
-        simulator.send_signal(signal.SIGTERM)
-        _, shown = simulator.communicate(timeout=10)
+        shown = stop_simulator(simulator)
     assert "joint 3: move only joint 3" in shown
     document = analyze_json(path)
     assert document["procedure"] == "joint_troubleshooting"
@@ -203,8 +188,7 @@ def test_gain_schedule_session_from_typed_gains(tmp_path: Path):
             str(inputs),
         )
     finally:
-        simulator.send_signal(signal.SIGTERM)
-        simulator.communicate(timeout=10)
+        stop_simulator(simulator)
     document = analyze_json(path)
     assert list(document["gains"]) == ["kp", "ki", "kd"]
     assert document["gains"]["kp"]["order"] == 3
@@ -238,16 +222,14 @@ def test_a_repeatability_session_says_which_gauge_check_covers_it(tmp_path: Path
             *("--input", "tolerance=0.004"),
         )
     finally:
-        bench.send_signal(signal.SIGTERM)
-        bench.communicate(timeout=10)
+        stop_simulator(bench)
     fixture, url = simulate("--unit", "in", "--resolution", "0.0001")
     try:
         path, summary = capture(
             url, tmp_path / "sessions", "repeatability", "--cycles", "3", "--gauge", "x=MIT-0042"
         )
     finally:
-        fixture.send_signal(signal.SIGTERM)
-        fixture.communicate(timeout=10)
+        stop_simulator(fixture)
     today = load_session(path).created[:10]
     passed = f"x: gauge MIT-0042: gauge check passed on {today}"
     assert passed in summary
@@ -280,8 +262,7 @@ def test_a_failed_gauge_check_warns_in_the_next_session(tmp_path: Path):
     try:
         path, summary = capture(url, tmp_path / "sessions", "repeatability", "--cycles", "3")
     finally:
-        fixture.send_signal(signal.SIGTERM)
-        fixture.communicate(timeout=10)
+        stop_simulator(fixture)
     assert "y: WARNING: gauge DIAL-7: its last gauge check" in summary
     assert "failed" in summary
     assert load_session(path).header["gauges"] == {"y": "DIAL-7"}
@@ -331,8 +312,7 @@ def test_a_register_that_cannot_be_written_is_a_warning_not_a_lost_check(tmp_pat
             env={**os.environ, "STATION_GAUGES": str(link)},
         )
     finally:
-        bench.send_signal(signal.SIGTERM)
-        bench.communicate(timeout=10)
+        stop_simulator(bench)
     assert done.returncode == 0, done.stderr
     assert "station: warning: the gauge register" in done.stderr
     assert "symbolic link" in done.stderr

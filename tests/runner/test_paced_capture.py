@@ -3,18 +3,16 @@
 
 from __future__ import annotations
 
-import signal
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
+from helpers import STATION, start_simulator, stop_simulator
 
 from station.instruments.simulator import AxisModel, FixtureModel, GaugeSpec
 from station.session.model import load_session
 
-STATION = [sys.executable, "-m", "station"]
 PERIOD = 0.5
 SEED = 5
 NOISE = 0.01
@@ -66,23 +64,9 @@ def procedures(tmp_path: Path) -> Path:
 
 def simulate(*extra: str) -> tuple[subprocess.Popen, str]:
     """``station simulate`` (Mitutoyo, x y z in mm at 0.001) as a subprocess; its URL."""
-    process = subprocess.Popen(
-        [*STATION, "simulate", "--protocol", "mitutoyo", "--seed", str(SEED)]
-        + ["--noise", str(NOISE), *extra],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
+    return start_simulator(
+        "--protocol", "mitutoyo", "--seed", str(SEED), "--noise", str(NOISE), *extra
     )
-    url = process.stdout.readline().strip()
-    if not url:
-        process.kill()
-        pytest.fail(f"no URL: {process.communicate()[1]}")
-    return process, url
-
-
-def stop(process: subprocess.Popen) -> None:
-    process.send_signal(signal.SIGTERM)
-    process.communicate(timeout=10)
 
 
 def capture(*args: str, timeout: float = 90) -> subprocess.CompletedProcess:
@@ -117,7 +101,7 @@ def test_arrival_records_ten_cycles_one_per_round_trip_at_rest(
             "--sessions", str(tmp_path / "s"), "--cycles", "10", "--timeout", "3",
         )  # fmt: skip
     finally:
-        stop(process)
+        stop_simulator(process)
     assert done.returncode == 0, done.stderr
     session = load_session(next((tmp_path / "s").glob("*.jsonl")))
     assert session.header["instruments"]["trigger"] == "arrival"  # the procedure's default
@@ -153,7 +137,7 @@ def test_a_return_that_does_not_settle_is_reported_not_recorded(
             "--sessions", str(tmp_path / "s"), "--cycles", "4", "--timeout", "3",
         )  # fmt: skip
     finally:
-        stop(process)
+        stop_simulator(process)
     assert done.returncode == 0, done.stderr
     assert "but y was not still" in done.stderr
     session = load_session(next((tmp_path / "s").glob("*.jsonl")))
@@ -187,7 +171,7 @@ def test_every_paces_polled_cycles(tmp_path: Path, procedures: Path) -> None:
         )  # fmt: skip
         elapsed = time.monotonic() - started
     finally:
-        stop(process)
+        stop_simulator(process)
     assert done.returncode == 0, done.stderr
     session = load_session(next((tmp_path / "s").glob("*.jsonl")))
     times = [min(r.t_mono for r in session.cycles[n].readings.values()) for n in session.cycles]
@@ -205,7 +189,7 @@ def test_a_mm_simulator_against_an_inch_session_is_refused_naming_both(tmp_path:
             "--every", "0.01",
         )  # fmt: skip
     finally:
-        stop(process)
+        stop_simulator(process)
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1, done.stderr
     assert (
@@ -250,7 +234,7 @@ def test_at_a_terminal_poll_waits_for_enter_before_each_cycle(
         out, err = capture_process.communicate(timeout=60)
     finally:
         os.close(master)
-        stop(process)
+        stop_simulator(process)
     assert capture_process.returncode == 0, err
     assert prompts == [f"Cycle {n} of 3.  [Enter]" for n in (1, 2, 3)]
 

@@ -6,12 +6,11 @@ error per axis and keeps the pendant coordinates with each placement."""
 from __future__ import annotations
 
 import json
-import signal
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from helpers import STATION, start_simulator, stop_simulator
 
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import GaugeSpec, Simulator, TwoFixtureModel
@@ -19,7 +18,6 @@ from station.procedures import discover_procedures
 from station.run import PortSetup, Runner, SessionSetup
 from station.session.model import load_session
 
-STATION = [sys.executable, "-m", "station"]
 SCALE = (2.0e-5, -1.5e-5, 1.0e-5)
 NOISE = 0.0001
 PLACEMENTS = 8
@@ -117,32 +115,20 @@ def write_inputs(path: Path, seed: int) -> Path:
 
 
 def start_two_fixture(seed: int) -> tuple[subprocess.Popen, str]:
-    process = subprocess.Popen(
-        [
-            *STATION,
-            "simulate",
-            "--protocol",
-            "mitutoyo",
-            "--model",
-            "two-fixture",
-            "--seed",
-            str(seed),
-            "--scale",
-            ",".join(f"{a}={v}" for a, v in zip("xyz", SCALE, strict=True)),
-            "--rotation",
-            "0",
-            "--noise",
-            str(NOISE),
-        ],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
+    return start_simulator(
+        "--protocol",
+        "mitutoyo",
+        "--model",
+        "two-fixture",
+        "--seed",
+        str(seed),
+        "--scale",
+        ",".join(f"{a}={v}" for a, v in zip("xyz", SCALE, strict=True)),
+        "--rotation",
+        "0",
+        "--noise",
+        str(NOISE),
     )
-    url = process.stdout.readline().strip()
-    if not url:
-        process.kill()
-        pytest.fail(f"the simulator gave no URL: {process.communicate()[1]}")
-    return process, url
 
 
 def capture_args(url: str, folder: Path, inputs: Path) -> list[str]:
@@ -182,8 +168,7 @@ def test_station_capture_against_station_simulate_two_fixture(tmp_path: Path) ->
             timeout=60,
         )
     finally:
-        simulator.send_signal(signal.SIGTERM)
-        _, shown = simulator.communicate(timeout=10)
+        shown = stop_simulator(simulator)
     assert done.returncode == 0, done.stderr
     assert sum(line.startswith("cycle ") for line in done.stdout.splitlines()) == PLACEMENTS
     assert "RELATIVE ACCURACY REPORT" in done.stdout

@@ -17,7 +17,8 @@ import pytest
 from station.cli import main
 from station.errors import StationError
 from station.session.journal import SessionWriter
-from station.session.model import encode_line, line_hash, load_session, replay_bytes
+from station.session.lines import encode_line, line_hash
+from station.session.model import load_session, replay_bytes
 from station.session.verify import verify_session
 
 from .conftest import reading_fields, session_header_fields, write_session

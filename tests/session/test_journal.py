@@ -15,7 +15,8 @@ import pytest
 
 from station.errors import StationError
 from station.session.journal import SessionWriter, sanitise_name
-from station.session.model import FORMAT, decode_line, load_session
+from station.session.lines import FORMAT, decode_line
+from station.session.model import load_session
 
 from .conftest import reading_fields, session_header_fields, write_session
 

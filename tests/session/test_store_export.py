@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import csv
 import io
+import subprocess
+import sys
 from pathlib import Path
 
 from station.session.export import CSV_COLUMNS, export_csv
@@ -71,3 +73,22 @@ def test_export_csv_is_tidy_and_marks_rejected_cycles(tmp_path: Path) -> None:
     assert row[6:8] == [repr(expected["raw_value"]), "0.375"]
     assert [r[4] for r in rows[1:4]] == ["ok"] * 3
     assert [(r[0], r[1]) for r in rows[1:]] == [(str(c), ch) for c in (1, 2, 3) for ch in "xyz"]
+
+
+def test_listing_sessions_loads_no_numpy(tmp_path: Path) -> None:
+    """The home screen lists the sessions folder as it appears: reading every header, event and
+    reading of the listed files must not load numpy (the session model defers it)."""
+    folder = tmp_path / "sessions"
+    write_session(folder, robot="alpha", finish=False)
+    write_session(folder, robot="zeta", finish=True)
+    probe = (
+        "import sys\n"
+        "from station.session.store import find_unfinished, list_sessions, status_words\n"
+        f"listed = list_sessions({str(folder)!r})\n"
+        f"unfinished = find_unfinished({str(folder)!r})\n"
+        "words = [status_words(summary) for summary in listed]\n"
+        "print(len(listed), len(unfinished), 'numpy' in sys.modules)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["2", "1", "False"]

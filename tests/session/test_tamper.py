@@ -120,7 +120,7 @@ _JSON = st.recursive(
 @given(st.lists(st.dictionaries(st.sampled_from(_KEYS), _JSON, max_size=6), max_size=4))
 def test_well_chained_lines_with_arbitrary_content_load_or_raise_station_error(events) -> None:
     # Every line has a valid hash and chain, so the content checks themselves are exercised.
-    from station.session.model import encode_line, line_hash
+    from station.session.lines import encode_line, line_hash
 
     lines = [DATA.split(b"\n")[0]]
     for number, event in enumerate(events, start=1):

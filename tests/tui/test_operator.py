@@ -636,7 +636,13 @@ async def test_exporting_from_the_summary_says_so_without_covering_it(
         await pilot.press("e")
         await pilot.pause(0.3)
         message = app.screen.query_one("#summary-message", Static)
-        assert "report exported to" in str(message.render())
+        # Both files said, whole, on the screen (the HTML report's path was cut at the edge,
+        # the text report not said at all); their full paths are in the session file's block.
+        said = "Report filed beside the session file, as .report.txt and .report.html"
+        assert said in tui.screen_text(app), tui.screen_text(app)
+        block = str(app.screen.query_one("#summary-file", Static).render())
+        stem = saved.name.removesuffix(".jsonl")
+        assert f"{stem}.report.txt" in block and f"{stem}.report.html" in block
         assert message.region and message.region.y < 23  # above the footer, in view
         assert not list(app.query(Toast)), "a toast covers the summary"
 
@@ -692,7 +698,8 @@ async def test_linearity_one_sided_limits_are_explained_on_screen(
             ),
         )
         verdict = str(app.screen.query_one("#summary-verdict", Static).render())
-        assert "one-sided: upper limit 0.00200 in only" in verdict, verdict
+        # Signed like every limit on the screen (the histogram's "USL +0.00200").
+    assert "one-sided: upper limit +0.00200 in only" in verdict, verdict
 
 
 async def test_long_alarm_texts_open_in_full(tmp_path: Path, alarming_fixture, tui) -> None:

@@ -71,6 +71,10 @@ async def test_out_of_spec_flagged_live_and_nine_cycles_are_provisional(
         verdict = " ".join(str(app.screen.query_one("#summary-verdict", Static).render()).split())
         assert "Verdict: PROVISIONAL: 9 of 25" in verdict, verdict
         assert "CAPABLE" not in verdict
+        # Finding 9: each axis' figures on one line at 80 columns ("σ" was left at a line's
+        # end with its value on the next, after "PROVISIONAL: 9 of 25" on every axis).
+        shown_lines = tui.screen_text(app).splitlines()
+        assert not [line for line in shown_lines if line.rstrip().endswith("σ")], shown_lines
         cycles = ", ".join(str(c) for c in out.cycles)
         assert f"out of specification: {out.total} reading" in verdict
         assert f"cycle{'s' if out.total > 1 else ''} {cycles}" in verdict

@@ -8,13 +8,13 @@ from __future__ import annotations
 import datetime as dt
 import json
 import os
-import signal
 import subprocess
 import sys
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from helpers import start_simulator, stop_simulator
 from textual.widgets import Input, Static
 
 from station.session.gauge_register import load_register
@@ -31,20 +31,11 @@ PROTOCOL = "mitutoyo"
 @pytest.fixture
 def simulator(request) -> Iterator[str]:
     """``station simulate`` with the test's arguments (``request.param``); its URL."""
-    process = subprocess.Popen(
-        [*STATION, "simulate", "--protocol", PROTOCOL, *request.param],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    url = process.stdout.readline().strip()
+    process, url = start_simulator("--protocol", PROTOCOL, *request.param)
     try:
-        if not url:
-            pytest.fail(f"the simulator gave no URL: {process.communicate(timeout=10)[1]}")
         yield url
     finally:
-        process.send_signal(signal.SIGTERM)
-        process.communicate(timeout=10)
+        stop_simulator(process)
 
 
 def text_of(app: StationApp, selector: str) -> str:

@@ -4,7 +4,7 @@ deviation plot, the buffer of the stroke under way, the set-up's count field."""
 from __future__ import annotations
 
 from station.procedures import discover_procedures
-from station.tui.screens.setup import count_field, judged_channels
+from station.tui.screens.setup_form import count_field, judged_channels
 from station.tui.screens.strokes import LiveStroke
 from station.tui.widgets.deviation_plot import DeviationData, Trace, render_deviation, trace
 
@@ -14,7 +14,9 @@ def test_the_deviation_plot_puts_each_stroke_where_its_deviation_is() -> None:
     bow = Trace((0.0, 10.0, 20.0), (0.0, 0.001, 0.0))
     flat = Trace((0.0, 10.0, 20.0), (0.0, 0.0, 0.0))
     lines = render_deviation(
-        DeviationData("h", earlier=(), newest=bow, current=flat, decimals=5, unit="in"), 40, 9
+        DeviationData("h", earlier=(), newest=bow, current=flat, resolution=0.0001, unit="in"),
+        40,
+        9,
     ).plain.splitlines()
     assert len(lines) == 9
     assert lines[0].startswith("h − LS line (in) vs s") and "● now" in lines[0]
@@ -24,7 +26,8 @@ def test_the_deviation_plot_puts_each_stroke_where_its_deviation_is() -> None:
     zero = next(i for i, row in enumerate(rows) if "+0.00000" in row)
     assert rows[zero].count("●") == 3  # the flat stroke on the zero line
     assert rows[-1].strip().startswith("-0.00100")
-    assert "s 0.00" in lines[-1] and lines[-1].rstrip().endswith("20.00")
+    # The position along the bar at the figures' decimals, like every number on the screen.
+    assert "s 0.00000" in lines[-1] and lines[-1].rstrip().endswith("20.00000")
 
 
 def test_no_stroke_yet_says_so() -> None:

@@ -9,6 +9,7 @@ FILE --json`` gives the figures the summary showed.
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 import time
@@ -145,6 +146,11 @@ async def test_relative_accuracy_through_the_tui(tmp_path: Path, lab: DemoLab, t
             )
         await tui.wait_until(pilot, lambda: isinstance(app.screen, DashboardScreen))
         await pilot.pause()
+        app.redraw_live()
+        await pilot.pause()
+        # Finding 9: the prompt said "Every cycle asked for is captured" of placements.
+        prompt = text_of(app, "#dash-prompt")
+        assert "Every placement asked for is captured" in prompt, prompt
         await pilot.press("f")
         await tui.wait_until(pilot, lambda: isinstance(app.screen, SummaryScreen))
         await tui.wait_until(pilot, lambda: bool(app.screen.query("#summary-report")))
@@ -206,8 +212,12 @@ async def test_linearity_through_the_tui(tmp_path: Path, lab: DemoLab, tui) -> N
         await pilot.pause(0.3)
         assert "3 of 3 strokes done" in text_of(app, "#dash-title")
         assert "Press f to finish" in text_of(app, "#dash-prompt")
+        # Finding 9: one number format on the screen (the plot's position axis read "s 0.00").
+        assert tui.odd_figures(tui.screen_text(app)) == [], tui.screen_text(app)
         plot = str(dashboard.query_one("#stroke-plot").render())
         assert "h − LS line" in plot and "•" in plot
+        # The position along the bar at the figures' decimals too (it read "s 0.00").
+        assert re.search(r"s -?\d+\.\d{5} +-?\d+\.\d{5}$", plot.splitlines()[-1].rstrip()), plot
         chart = str(dashboard.query_one("#stroke-chart").render())
         assert "stroke " in chart and "CL" in chart
         live = [
@@ -267,6 +277,10 @@ async def test_a_linearity_session_left_and_resumed_goes_on_from_its_strokes(
         # The strokes recorded before the break are drawn again, and streaming goes on to 4.
         await tui.wait_until(pilot, lambda: dashboard.result is not None, timeout=30)
         assert len(dashboard.result.strokes) >= 2
+        # The verdict so far is the table's (PROVISIONAL below 25 strokes), never a bare
+        # CAPABLE beside rows that say PROVISIONAL.
+        prompt = text_of(app, "#dash-prompt")
+        assert "Verdict so far: PROVISIONAL: " in prompt, prompt
         await tui.wait_until(
             pilot,
             lambda: app.runner.state().progress.done >= 4 and not dashboard.streaming,

@@ -7,6 +7,8 @@ table (words, not only colours), all within the cells they are given.
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from rich.cells import cell_len
@@ -15,11 +17,17 @@ from rich.console import Console
 from station.analysis.capability import SpecLimits
 from station.analysis.summary import AnalysisConfig, analyze
 from station.errors import StationError
-from station.text import overall_verdict, verdict_word
-from station.tui.screens.setup import limits_text, parse_channel_map, parse_limits_text
+from station.text import (
+    figure_decimals,
+    format_figure,
+    limits_text,
+    overall_verdict,
+    parse_channel_map,
+    parse_limits_text,
+    verdict_word,
+)
 from station.tui.widgets.alarm_log import alarm_lines
 from station.tui.widgets.control_chart import chart_data, render_chart
-from station.tui.widgets.figures import decimals_for, number
 from station.tui.widgets.histogram import histogram_data, render_histogram
 from station.tui.widgets.stats_panel import StatsRows, stats_table
 
@@ -44,12 +52,39 @@ def _plain(text) -> list[str]:
 
 def test_histogram_fits_its_cells_and_marks_both_limits() -> None:
     channel = _analysis().channels["x"]
-    lines = _plain(render_histogram(histogram_data(channel, 5), 36, 10))
+    lines = _plain(render_histogram(histogram_data(channel, RESOLUTION), 36, 10))
     assert len(lines) == 10
     assert all(len(line) <= 36 for line in lines)
     assert "LSL -0.00100" in lines[-1] and "USL +0.00100" in lines[-1]
     assert lines[-2].count("┴") == 2  # both limits marked on the axis
     assert any(ch in "".join(lines[1:-2]) for ch in "▁▂▃▄▅▆▇█")
+
+
+def _histogram_lines(values: list[float], width: int) -> list[str]:
+    limits = {"x": SpecLimits(lsl=-0.001, usl=0.001, nominal=0.0)}
+    config = AnalysisConfig(limits=limits, resolution=RESOLUTION, unit="in")
+    channel = analyze({"x": np.array(values)}, config).channels["x"]
+    return _plain(render_histogram(histogram_data(channel, RESOLUTION), width, 10))
+
+
+@pytest.mark.parametrize("width", [28, 36, 50])
+def test_histogram_bars_never_cross_a_limit_and_equal_counts_are_equally_wide(width) -> None:
+    """Finding 9: a bar stood over the USL border, and bins of equal counts were drawn one or
+    two cells wide depending on where they fell."""
+    # Three readings each at four values inside, two at the USL itself, one beyond it.
+    values = [-0.0005] * 3 + [0.0] * 3 + [0.0003] * 3 + [0.0007] * 3 + [0.001] * 2 + [0.0012]
+    lines = _histogram_lines(values, width)
+    bars, axis = lines[1:-2], lines[-2]
+    usl_column = axis.rindex("┴")
+    lsl_column = axis.index("┴")
+    for row in bars:
+        assert row[usl_column] == "│" and row[lsl_column] == "│", row
+    # The readings at the USL stand left of its mark, the one beyond it right of it.
+    bottom = bars[-1]
+    assert bottom[usl_column - 1] != " " and bottom[usl_column + 1 :].strip()
+    # The four bins of three readings: as wide as each other, and as tall.
+    runs = re.findall(r"[▁▂▃▄▅▆▇█]+", bars[0])
+    assert len(runs) == 4 and len({len(run) for run in runs}) == 1, bars[0]
 
 
 def test_histogram_without_data_says_so() -> None:
@@ -61,7 +96,7 @@ def test_chart_marks_the_alarm_point_and_draws_the_lines() -> None:
     channel = analysis.channels["z"]
     assert channel.alarms, "the shifted point must raise an alarm"
     cycles = list(range(1, 31))
-    lines = _plain(render_chart(chart_data(channel, cycles, 5), 44, 10))
+    lines = _plain(render_chart(chart_data(channel, cycles, RESOLUTION), 44, 10))
     assert len(lines) == 10
     assert all(len(line) <= 44 for line in lines)
     body = "\n".join(lines)
@@ -72,7 +107,7 @@ def test_chart_marks_the_alarm_point_and_draws_the_lines() -> None:
 
 def test_chart_keeps_the_newest_points_when_crowded() -> None:
     channel = _analysis(n=60).channels["x"]
-    lines = _plain(render_chart(chart_data(channel, list(range(1, 61)), 5), 40, 8))
+    lines = _plain(render_chart(chart_data(channel, list(range(1, 61)), RESOLUTION), 40, 8))
     assert "(last 26 of 60)" in lines[0]
     assert lines[-1].strip().endswith("60")
 
@@ -83,7 +118,7 @@ def test_stats_table_writes_verdict_words_within_80_columns() -> None:
         channels=("x", "y", "z"),
         analyses=analysis.channels,
         last={"x": 0.0001, "y": -0.0002, "z": 0.0},
-        decimals=decimals_for(RESOLUTION),
+        resolution=RESOLUTION,
         selected="y",
     )
     console = Console(width=78, record=True, color_system=None)
@@ -148,9 +183,13 @@ def test_channel_map_field() -> None:
 
 
 def test_figures() -> None:
-    assert decimals_for(0.0001) == 5
-    assert decimals_for(0.001) == 4
-    assert number(None, 3) == "—" and number(float("nan"), 3) == "—"
+    assert figure_decimals(0.0001) == 5
+    assert figure_decimals(0.001) == 4
+    assert format_figure(None, 0.001) == "-" and format_figure(float("nan"), 0.001) == "-"
+    # Never scientific, never a signed spread, never "-0": one format for every figure.
+    assert format_figure(4.11e-05, RESOLUTION) == "+0.00004"
+    assert format_figure(0.00022, RESOLUTION, signed=False) == "0.00022"
+    assert format_figure(-0.000004, RESOLUTION) == "+0.00000"
     assert overall_verdict(["CAPABLE", "NOT CAPABLE"]) == "NOT CAPABLE"
     assert overall_verdict(["CAPABLE", "CAPABLE"]) == "CAPABLE"
     assert overall_verdict(["CAPABLE", "UNDEFINED"]) == "UNDEFINED"
@@ -162,7 +201,7 @@ def test_stats_table_flags_out_of_spec_and_says_provisional() -> None:
         channels=("x", "y", "z"),
         analyses=analysis.channels,
         last={"x": 0.0001, "y": 0.0011, "z": -0.00105},
-        decimals=decimals_for(RESOLUTION),
+        resolution=RESOLUTION,
         flags={"y": "above", "z": "below"},
     )
     console = Console(width=76, record=True, color_system=None)

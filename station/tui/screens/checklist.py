@@ -19,7 +19,9 @@ from textual.screen import Screen
 from textual.widgets import Footer, Input, Label, Static
 
 from station.errors import StationError
+from station.text import format_value
 from station.tui.remedies import explained
+from station.tui.screens.dialogs import ConfirmScreen, HelpScreen, TextPrompt
 from station.tui.text import shown, shown_line
 from station.tui.widgets.fields import mark_focused_row
 from station.tui.widgets.step_list import StepList
@@ -203,8 +205,21 @@ class ChecklistScreen(Screen[None]):
             }
             self._do(lambda: runner.submit_input(values))
         elif kind == "zero":
-            self.query_one("#step-message", Static).update(Text("Zeroing ...", style="yellow"))
-            self._do(runner.zero)
+            fixture = self.app.demo_fixture
+            if fixture is None:
+                self.query_one("#step-message", Static).update(Text("Zeroing ...", style="yellow"))
+                self._do(runner.zero)
+                return
+            # The demo's robot never stops: zero when it has just come to rest at the fixture.
+            self.query_one("#step-message", Static).update(
+                Text("Zeroing once the simulated robot is at rest at the fixture ...", "yellow")
+            )
+
+            def zero_at_rest() -> None:
+                fixture.wait_at_rest()
+                runner.zero()
+
+            self._do(zero_at_rest)
         else:
             self._do(runner.confirm)
 
@@ -230,7 +245,6 @@ class ChecklistScreen(Screen[None]):
 
     def action_note(self) -> None:
         """A free-text note in the session file."""
-        from station.tui.screens.dialogs import TextPrompt
 
         def save(text: str | None) -> None:
             if text and self.app.runner is not None:
@@ -240,13 +254,11 @@ class ChecklistScreen(Screen[None]):
 
     def action_help(self) -> None:
         """The keys."""
-        from station.tui.screens.dialogs import HelpScreen
 
         self.app.push_screen(HelpScreen())
 
     def action_leave(self) -> None:
         """Leave the session unfinished (it is marked interrupted and offered for resume)."""
-        from station.tui.screens.dialogs import ConfirmScreen
 
         def leave(sure: bool | None) -> None:
             if sure:
@@ -265,7 +277,6 @@ class ChecklistScreen(Screen[None]):
 def captured_text(record: Any, header: dict[str, Any]) -> Text:
     """``Captured (set 3): x +0.0003  y -0.0001  z +0.0002 in``: the set just recorded, at
     the gauge's resolution."""
-    from station.text import format_value
 
     resolution = header.get("resolution")
     unit = str(header.get("unit") or "")

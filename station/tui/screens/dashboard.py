@@ -22,12 +22,13 @@ from textual.screen import Screen
 from textual.widgets import Footer, Static
 
 from station.errors import StationError
+from station.text import format_figure
 from station.tui.messages import CaptureFinished
 from station.tui.remedies import explained
+from station.tui.screens.dialogs import ConfirmScreen, FullTextScreen, HelpScreen, TextPrompt
 from station.tui.text import shown, shown_line
 from station.tui.widgets.alarm_log import AlarmLog, alarm_lines, recorded_alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
-from station.tui.widgets.figures import decimals_for
 from station.tui.widgets.histogram import HistogramView, histogram_data
 from station.tui.widgets.instrument_status import InstrumentStatus, status_text
 from station.tui.widgets.stats_panel import StatsPanel, StatsRows
@@ -101,7 +102,10 @@ class DashboardView:
         if state.placement is not None and state.placements:
             progress = f"placement {state.placement} of {state.placements}, {progress}"
         if ready:
-            noun = counted.noun if counted is not None else "cycle"
+            # After the last step of a repeated block (relative accuracy) nothing counts any
+            # more: what was asked for were placements, not cycles.
+            placed = last_cycle is not None and last_cycle.placement is not None
+            noun = counted.noun if counted is not None else "placement" if placed else "cycle"
             prompt = f"Every {noun} asked for is captured. Press f to finish and see the verdict."
         if rejected:
             progress += f", {rejected} rejected"
@@ -135,16 +139,14 @@ class DashboardView:
 
 
 def zero_line(zero: Mapping[str, Any], resolution: float | None) -> str:
-    """The zero in force in one compact line: ``zero x +0.0003 y -0.0001 z +0.0002 (5
-    readings)``; '' before any zero."""
+    """The zero in force in one compact line: ``zero x +0.00030 y -0.00010 z +0.00020 (5
+    readings)`` (at the table's decimals); '' before any zero."""
     if not zero:
         return ""
-    from station.text import format_value
-
     parts = [
         f"{channel} device"
         if spec.get("method") == "device"
-        else f"{channel} {format_value(spec.get('offset'), resolution)}"
+        else f"{channel} {format_figure(spec.get('offset'), resolution)}"
         for channel, spec in zero.items()
     ]
     counts = {spec.get("n") for spec in zero.values()}
@@ -268,7 +270,7 @@ class DashboardScreen(Screen[None]):
                 channels=view.channels,
                 analyses=view.analyses,
                 last=view.last,
-                decimals=decimals_for(view.resolution),
+                resolution=view.resolution,
                 unit=view.unit,
                 selected=self.selected,
                 flags=view.flags,
@@ -279,11 +281,10 @@ class DashboardScreen(Screen[None]):
     def draw(self, view: DashboardView) -> None:
         """Put ``view`` on screen."""
         self._draw_text(view)
-        decimals = decimals_for(view.resolution)
         selected = view.analyses.get(self.selected)
-        self.query_one(HistogramView).show(histogram_data(selected, decimals))
+        self.query_one(HistogramView).show(histogram_data(selected, view.resolution))
         self.query_one(ControlChartView).show(
-            chart_data(selected, list(view.cycle_numbers), decimals)
+            chart_data(selected, list(view.cycle_numbers), view.resolution)
         )
         log = self.query_one(AlarmLog)
         if view.alarms is not None:
@@ -371,7 +372,10 @@ class DashboardScreen(Screen[None]):
             self._say(message.error, "bold red")
         elif message.outcome is not None:
             outcome = message.outcome
-            self._say(outcome.message, "green" if outcome.recorded else "bold red")
+            # A recorded cycle in the table's own format (the engine words it as the gauge
+            # shows it, for the command line).
+            said = outcome.cycle.line(figures=True) if outcome.cycle is not None else None
+            self._say(said or outcome.message, "green" if outcome.recorded else "bold red")
 
     def _in_thread(self, call: Callable[[], Any]) -> None:
         if self._action_busy:
@@ -408,7 +412,6 @@ class DashboardScreen(Screen[None]):
         if reason is not None:
             self._in_thread(lambda: runner.reject_last(reason))
             return
-        from station.tui.screens.dialogs import TextPrompt
 
         def reject(text: str | None) -> None:
             if text:
@@ -428,7 +431,6 @@ class DashboardScreen(Screen[None]):
         runner = self.app.runner
         if not self.live or runner is None:
             return
-        from station.tui.screens.dialogs import TextPrompt
 
         def save(text: str | None) -> None:
             if text:
@@ -461,7 +463,6 @@ class DashboardScreen(Screen[None]):
             return
         counted = state.progress
         if counted is not None and not counted.enough and not force:
-            from station.tui.screens.dialogs import ConfirmScreen
 
             def finish(sure: bool | None) -> None:
                 if sure:
@@ -483,7 +484,7 @@ class DashboardScreen(Screen[None]):
 
     def action_alarms(self) -> None:
         """The alarm list: every alarm in full, acknowledged with a cause (live) or read."""
-        from station.tui.screens.alarms import AlarmsScreen
+        from station.tui.screens.alarms import AlarmsScreen  # deferred: loads when shown
 
         view = self.view
         alarms = tuple(view.alarms or ()) if view is not None else ()
@@ -503,13 +504,11 @@ class DashboardScreen(Screen[None]):
 
     def action_help(self) -> None:
         """The keys."""
-        from station.tui.screens.dialogs import HelpScreen
 
         self.app.push_screen(HelpScreen())
 
     def action_full_text(self) -> None:
         """``m``: the newest message and every alarm, in full (the lines here cut them)."""
-        from station.tui.screens.dialogs import FullTextScreen
 
         view = self.view
         lines: list[str] = []
@@ -533,7 +532,6 @@ class DashboardScreen(Screen[None]):
         if not self.live:
             self.app.pop_screen()
             return
-        from station.tui.screens.dialogs import ConfirmScreen
 
         def leave(sure: bool | None) -> None:
             if sure:
@@ -552,7 +550,7 @@ class DashboardScreen(Screen[None]):
 def out_of_spec_flags(last: Mapping[str, float], header: Mapping[str, Any]) -> dict[str, str]:
     """Channel -> "above" / "below" for each last reading beyond the session's specification
     limits (flagged the moment the reading is on disk, before the analysis catches up)."""
-    from station.session.header import header_limits
+    from station.session.header import header_limits  # deferred: it loads numpy
 
     flags: dict[str, str] = {}
     for channel, limits in header_limits(header).items():

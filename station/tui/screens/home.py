@@ -17,7 +17,11 @@ from textual.screen import Screen
 from textual.widgets import Footer, OptionList, Static
 from textual.widgets.option_list import Option
 
+from station.errors import StationError
+from station.session.store import find_unfinished, list_sessions
+from station.tui.instruments import DEMO_PROCEDURES
 from station.tui.remedies import explained
+from station.tui.screens.dialogs import HelpScreen
 from station.tui.text import shown, shown_line
 
 if TYPE_CHECKING:
@@ -71,12 +75,9 @@ class HomeScreen(Screen[None]):
 
     def reload(self) -> None:
         """Read the sessions folder again and rebuild the list."""
-        from station.errors import StationError
 
         config = self.app.config
         try:
-            from station.session.store import find_unfinished, list_sessions
-
             self._unfinished = list(find_unfinished(config.sessions_dir))
             self._session_count = len(list_sessions(config.sessions_dir))
         except StationError as error:
@@ -92,8 +93,6 @@ class HomeScreen(Screen[None]):
             Option("New session (choose the procedure, robot, limits and port)", id="new")
         )
         if config.demo_lab is not None:
-            from station.tui.instruments import DEMO_PROCEDURES
-
             for procedure, setup in DEMO_PROCEDURES.items():
                 if procedure != config.demo.procedure:  # type: ignore[union-attr]
                     label = f"Demo {procedure.replace('_', ' ')} instead ({setup})"
@@ -124,8 +123,7 @@ class HomeScreen(Screen[None]):
 
     def open_new(self, procedure_id: str | None) -> None:
         """The set-up screen for a new session (of this procedure, else the default one)."""
-        from station.errors import StationError
-        from station.tui.screens.setup import SetupScreen
+        from station.tui.screens.setup import SetupScreen  # deferred: loads when shown
 
         try:
             self.app.catalog.get(procedure_id) if procedure_id else self.app.catalog.ids()[0]
@@ -137,7 +135,7 @@ class HomeScreen(Screen[None]):
 
     def open_resume(self, summary: Any) -> None:
         """The set-up screen for resuming this session (the port can be changed)."""
-        from station.tui.screens.setup import SetupScreen
+        from station.tui.screens.setup import SetupScreen  # deferred: loads when shown
 
         self.app.push_screen(SetupScreen(resume_path=summary.path))
 
@@ -156,13 +154,12 @@ class HomeScreen(Screen[None]):
 
     def action_review(self) -> None:
         """The list of saved sessions."""
-        from station.tui.screens.review import ReviewScreen
+        from station.tui.screens.review import ReviewScreen  # deferred: loads when shown
 
         self.app.push_screen(ReviewScreen())
 
     def action_help(self) -> None:
         """The keys and what the screens do."""
-        from station.tui.screens.dialogs import HelpScreen
 
         self.app.push_screen(HelpScreen())
 

@@ -61,7 +61,7 @@ class RecordScreen(Screen[None]):
 
 def history_screen(folder: Path, robot: str) -> RecordScreen:
     """Every session of ``robot`` in ``folder`` in time order, its charts and wear trend."""
-    from station.record.history import format_history, robot_history
+    from station.record.history import format_history, robot_history  # deferred: numpy
 
     return RecordScreen(
         f"History of robot {robot}", lambda: format_history(robot_history(folder, robot))
@@ -70,7 +70,7 @@ def history_screen(folder: Path, robot: str) -> RecordScreen:
 
 def compare_screen(before: Path, after: Path) -> RecordScreen:
     """Session ``after`` against ``before``: the shift and spread per axis, in sentences."""
-    from station.record.compare import compare_sessions
+    from station.record.compare import compare_sessions  # deferred: it loads numpy
 
     def lines() -> list[str]:
         comparison = compare_sessions(before, after)

@@ -19,8 +19,13 @@ from textual.screen import Screen
 from textual.widgets import DataTable, Footer, Static
 
 from station.errors import StationError
+from station.session.store import list_sessions, status_words
+from station.text import overall_verdict, verdict_word
 from station.tui.remedies import explained
+from station.tui.screens.dialogs import HelpScreen, TextPrompt
+from station.tui.screens.summary import SummaryScreen, SummaryView
 from station.tui.text import shown, shown_line
+from station.tui.theme import VERDICT_STYLES
 
 if TYPE_CHECKING:
     from station.tui.app import StationApp
@@ -59,7 +64,6 @@ class ReviewScreen(Screen[None]):
 
     def on_mount(self) -> None:
         """List the folder."""
-        from station.session.store import list_sessions
 
         folder = self.app.config.sessions_dir
         self._all = list(list_sessions(folder))
@@ -117,8 +121,6 @@ class ReviewScreen(Screen[None]):
         self.query_one("#review-folder", Static).update(shown(note, style="dim"))
 
     def _verdict_cell(self, summary: Any) -> Text:
-        from station.session.store import status_words
-        from station.tui.widgets.figures import VERDICT_STYLES
 
         if summary.error or summary.status != "finished":
             return shown(status_words(summary))
@@ -130,8 +132,6 @@ class ReviewScreen(Screen[None]):
     @work(thread=True, group="review-verdicts", exclusive=True, exit_on_error=False)
     def _work_out_verdicts(self, paths: list[Path]) -> None:
         """Thread worker: each finished session's overall verdict, as the summary says it."""
-        from station.text import overall_verdict, verdict_word
-        from station.tui.screens.summary import SummaryView
 
         for path in paths:
             try:
@@ -151,7 +151,6 @@ class ReviewScreen(Screen[None]):
 
     def action_filter(self) -> None:
         """``/``: show one robot's sessions (part of the name, any case; empty shows all)."""
-        from station.tui.screens.dialogs import TextPrompt
 
         def chosen(text: str | None) -> None:
             if text is None:
@@ -174,7 +173,6 @@ class ReviewScreen(Screen[None]):
 
     def action_open(self) -> None:
         """The summary of the highlighted session (read-only)."""
-        from station.tui.screens.summary import SummaryScreen, SummaryView
 
         table = self.query_one(DataTable)
         if not self._sessions or table.cursor_row < 0:
@@ -202,7 +200,7 @@ class ReviewScreen(Screen[None]):
 
     def action_history(self) -> None:
         """The highlighted robot's history: every session, its charts and wear trend."""
-        from station.tui.screens.record import history_screen
+        from station.tui.screens.record import history_screen  # deferred: loads when shown
 
         summary = self._highlighted()
         if summary is not None:
@@ -222,7 +220,7 @@ class ReviewScreen(Screen[None]):
 
     def action_compare(self) -> None:
         """Compare the highlighted session with the marked one (before → after)."""
-        from station.tui.screens.record import compare_screen
+        from station.tui.screens.record import compare_screen  # deferred: loads when shown
 
         summary = self._highlighted()
         if summary is None:
@@ -238,6 +236,5 @@ class ReviewScreen(Screen[None]):
 
     def action_help(self) -> None:
         """The keys."""
-        from station.tui.screens.dialogs import HelpScreen
 
         self.app.push_screen(HelpScreen())

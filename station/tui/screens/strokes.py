@@ -27,14 +27,17 @@ from textual.message import Message
 from textual.screen import Screen
 from textual.widgets import Footer, Static
 
+from station.analysis.linearity import least_squares_line
 from station.errors import StationError
-from station.text import overall_verdict, verdict_word
+from station.text import overall_judgement
 from station.tui.remedies import explained
+from station.tui.screens.dashboard import session_title
+from station.tui.screens.dialogs import ConfirmScreen, HelpScreen, TextPrompt
 from station.tui.text import shown
+from station.tui.theme import VERDICT_STYLES
 from station.tui.widgets.alarm_log import AlarmLog, alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.deviation_plot import DeviationData, DeviationPlot, trace
-from station.tui.widgets.figures import VERDICT_STYLES, decimals_for
 from station.tui.widgets.instrument_status import InstrumentStatus
 from station.tui.widgets.stats_panel import StatsPanel, StatsRows
 
@@ -86,7 +89,6 @@ class LiveStroke:
 
 def _deviations(s: list[float], d: list[float]) -> list[float]:
     """Deviations from the least-squares line of the points so far (the analysis' line)."""
-    from station.analysis.linearity import least_squares_line
 
     if len(s) < 3 or max(s) - min(s) <= 0:
         return []
@@ -166,12 +168,11 @@ class StrokeDashboardScreen(Screen[None]):
     def show_state(self, state: RunnerState) -> None:
         """Redraw from a runner snapshot and the newest stroke analysis (UI thread)."""
         header = self.app.session_header
-        decimals = decimals_for(header.get("resolution"))
+        resolution = header.get("resolution")
         unit = str(header.get("unit", ""))
         channels = self._channels()
         if self.selected not in channels:
             self.selected = channels[0]
-        from station.tui.screens.dashboard import session_title
 
         title = Text(session_title(header), style="bold")
         counted = state.progress
@@ -198,14 +199,14 @@ class StrokeDashboardScreen(Screen[None]):
                 channels=channels,
                 analyses=judged,
                 last=last,
-                decimals=decimals,
+                resolution=resolution,
                 unit=unit,
                 selected=self.selected,
             )
         )
-        self.query_one(DeviationPlot).show(self._deviation_data(decimals, unit))
+        self.query_one(DeviationPlot).show(self._deviation_data(resolution, unit))
         self.query_one(ControlChartView).show(
-            chart_data(judged.get(self.selected), numbers, decimals, label="stroke")
+            chart_data(judged.get(self.selected), numbers, resolution, label="stroke")
         )
         self.query_one(AlarmLog).show(alarm_lines(judged, numbers, label="stroke"))
         self.query_one(InstrumentStatus).show(tuple(state.instruments))
@@ -227,10 +228,11 @@ class StrokeDashboardScreen(Screen[None]):
             )
         text = Text()
         if self.result is not None:
-            words = [verdict_word(a.capability) for a in self.result.judged.values()]
-            overall = overall_verdict(words)
+            # The table's own judgement (PROVISIONAL below the minimum count), not a bare
+            # CAPABLE beside rows that say PROVISIONAL.
+            overall = overall_judgement(self.result.judged.values())
             text.append("Verdict so far: ", style="bold")
-            text.append(overall, style=VERDICT_STYLES.get(overall, ""))
+            text.append(overall, style=VERDICT_STYLES.get(overall.partition(":")[0], ""))
             text.append(" (straightness per stroke, minimum zone).  ")
         if self.streaming:
             text.append("Let the robot shuttle A↔B; e ends the stroke now, f finishes.")
@@ -238,7 +240,7 @@ class StrokeDashboardScreen(Screen[None]):
             text.append("Streaming is stopped. Space streams again; f finishes.")
         return text
 
-    def _deviation_data(self, decimals: int, unit: str) -> DeviationData:
+    def _deviation_data(self, resolution: float | None, unit: str) -> DeviationData:
         channel = self.selected
         earlier: list[Any] = []
         newest = None
@@ -257,7 +259,7 @@ class StrokeDashboardScreen(Screen[None]):
             earlier=tuple(earlier),
             newest=newest,
             current=current,
-            decimals=decimals,
+            resolution=resolution,
             unit=unit,
         )
 
@@ -325,7 +327,6 @@ class StrokeDashboardScreen(Screen[None]):
             return
         counted = state.progress
         if counted is not None and not counted.enough and not force:
-            from station.tui.screens.dialogs import ConfirmScreen
 
             def finish(sure: bool | None) -> None:
                 if sure:
@@ -372,7 +373,6 @@ class StrokeDashboardScreen(Screen[None]):
         runner = self.app.runner
         if runner is None:
             return
-        from station.tui.screens.dialogs import TextPrompt
 
         def save(text: str | None) -> None:
             if text:
@@ -385,13 +385,11 @@ class StrokeDashboardScreen(Screen[None]):
 
     def action_help(self) -> None:
         """The keys."""
-        from station.tui.screens.dialogs import HelpScreen
 
         self.app.push_screen(HelpScreen())
 
     def action_leave(self) -> None:
         """Leave the session resumable (the stroke under way is cut short)."""
-        from station.tui.screens.dialogs import ConfirmScreen
 
         def leave(sure: bool | None) -> None:
             if sure:

@@ -10,6 +10,7 @@ session; the words and figures come from the analysis and the report module, unc
 
 from __future__ import annotations
 
+import io
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,21 +25,23 @@ from textual.containers import VerticalScroll
 from textual.screen import Screen
 from textual.widgets import Footer, Static
 
+from station.analysis.rules import rule_name
 from station.errors import StationError
+from station.session.durable import write_text_durably
+from station.session.export import export_csv
+from station.session.model import load_session
 from station.text import (
+    format_figure,
+    format_index,
     judged_cpk,
-    judged_label,
     judged_word,
     overall_judgement,
+    zero_taken,
 )
 from station.tui.remedies import explained
+from station.tui.screens.dialogs import HelpScreen
 from station.tui.text import shown, shown_line
-from station.tui.widgets.figures import (
-    VERDICT_STYLES,
-    decimals_for,
-    number,
-    ratio,
-)
+from station.tui.theme import VERDICT_STYLES
 
 if TYPE_CHECKING:
     from station.run import RunnerState
@@ -81,7 +84,6 @@ class SummaryView:
     @classmethod
     def from_file(cls, path: Path) -> SummaryView:
         """A saved session, read-only (the file is not changed, not even a torn tail)."""
-        from station.session.model import load_session
 
         session = load_session(path, recover=False)
         report, notes = _procedure_report(path, session.header, session)
@@ -106,10 +108,10 @@ class SummaryView:
         return str(self.header.get("unit", ""))
 
     @property
-    def decimals(self) -> int:
-        """Decimals to show, from the gauge resolution."""
+    def resolution(self) -> float | None:
+        """The gauge's step (every figure is written at one decimal beyond it)."""
         resolution = self.header.get("resolution")
-        return decimals_for(float(resolution) if resolution else None)
+        return float(resolution) if resolution else None
 
 
 REPORT_WIDTH = 74
@@ -122,7 +124,7 @@ def _procedure_report(
     """The session's report as its analysis kind makes it (through the registry: the verdict,
     and for kinds with a report block of their own, that block), and a note saying why there
     is none when the file has nothing to analyse yet. ``session``: the file already loaded."""
-    from station.text import zero_taken
+    # Deferred: the analysis kinds load numpy (on a worker while the screens before it show).
     from station.verdicts import load_session_source, report_session, session_source
 
     try:
@@ -141,7 +143,7 @@ def report_text(view: SummaryView) -> Text:
     return shown("\n".join(view.report.lines), no_wrap=True, overflow="crop")
 
 
-def one_sided_sentence(capability: Any, decimals: int, unit: str) -> str:
+def one_sided_sentence(capability: Any, resolution: float | None, unit: str) -> str:
     """Why Cp shows "—" beside a Cpk: a limit on one side only (the straightness of a stroke,
     never below 0, against its tolerance) is judged one-sided; "" for two-sided limits."""
     lsl = getattr(capability, "lsl", None)
@@ -150,11 +152,11 @@ def one_sided_sentence(capability: Any, decimals: int, unit: str) -> str:
         return ""
     if usl is not None:
         return (
-            f"one-sided: upper limit {number(usl, decimals, signed=False)} {unit} only; "
+            f"one-sided: upper limit {format_figure(usl, resolution)} {unit} only; "
             "Cpk = (USL − X̄)/3σ, Cp needs two limits."
         )
     return (
-        f"one-sided: lower limit {number(lsl, decimals)} {unit} only; "
+        f"one-sided: lower limit {format_figure(lsl, resolution)} {unit} only; "
         "Cpk = (X̄ − LSL)/3σ, Cp needs two limits."
     )
 
@@ -182,16 +184,20 @@ def verdict_text(view: SummaryView) -> Text:
         word = judged_word(channel)
         capability = channel.capability
         descriptive = channel.descriptive
+        bound = capability.cpk_lower
+        lower = f"≥{format_index(bound)}" if bound is not None else format_index(None)
         text.append(f"  {shown_line(name, limit=20)}  ", style="bold")
-        text.append(f"{judged_label(channel):<11}", style=VERDICT_STYLES.get(word, ""))
+        # The word alone: the verdict line above says how many of how many (the axes share
+        # it), so the axis' figures fit one line at 80 columns ("σ" was left alone at its end).
+        text.append(f"{word:<11}", style=VERDICT_STYLES.get(word, ""))
         text.append(
-            f" Cp {ratio(capability.cp)}  Cpk {judged_cpk(channel)} (95%: ≥"
-            f"{ratio(capability.cpk_lower)})  X̄ {number(descriptive.mean, view.decimals)}"
-            f"  σ {number(descriptive.sd, view.decimals, signed=False)}\n"
+            f" Cp {format_index(capability.cp)}  Cpk {judged_cpk(channel)} (95%: {lower})  X̄ "
+            f"{format_figure(descriptive.mean, view.resolution)}"
+            f"  σ {format_figure(descriptive.sd, view.resolution, signed=False)}\n"
         )
         if word == "UNDEFINED" and capability.message:
             text.append(f"      {shown_line(capability.message, limit=None)}\n", style="yellow")
-        one_sided = one_sided_sentence(capability, view.decimals, view.unit)
+        one_sided = one_sided_sentence(capability, view.resolution, view.unit)
         if one_sided:
             text.append(f"      {one_sided}\n")
         found = channel.out_of_spec
@@ -210,7 +216,6 @@ def alarms_text(view: SummaryView) -> Text:
     """The alarms: those recorded while capturing (live, against the frozen limits) with their
     acknowledgements, and those of the retrospective chart (limits from every reading), each
     rule named in words and marked live or retrospective."""
-    from station.analysis.rules import rule_name
 
     text = Text("Alarms\n", style="bold")
     recorded = tuple(getattr(view.report, "recorded_alarms", None) or ())
@@ -254,17 +259,19 @@ def spatial_text(view: SummaryView) -> Text:
     spatial = getattr(view.analysis, "spatial", None)
     if spatial is None:
         return Text("")
-    decimals = view.decimals
+    resolution = view.resolution
     text = Text("3-D\n", style="bold")
-    offsets = "  ".join(f"{axis} {number(v, decimals)}" for axis, v in spatial.offset.items())
+    offsets = "  ".join(
+        f"{axis} {format_figure(v, resolution)}" for axis, v in spatial.offset.items()
+    )
     text.append(f"  offset from nominal: {offsets} {view.unit}\n")
     text.append(
         f"  total offset √(Σ offset²) (ISO 9283 APp): "
-        f"{number(spatial.total_offset, decimals, signed=False)} {view.unit}\n"
+        f"{format_figure(spatial.total_offset, resolution, signed=False)} {view.unit}\n"
     )
     text.append(
         f"  ISO 9283 pose repeatability RP = l̄ + 3·S_l: "
-        f"{number(spatial.rp, decimals, signed=False)} {view.unit}\n"
+        f"{format_figure(spatial.rp, resolution, signed=False)} {view.unit}\n"
     )
     if spatial.message:
         text.append(f"  {spatial.message}\n", style="yellow")
@@ -375,7 +382,7 @@ class SummaryScreen(Screen[None]):
         """The filed report (the same as ``station report FILE``: robot, operator, procedure,
         gauges, zero, limits, every reading, notes, alarms, verdicts, anchor, sign-off) beside
         the session file, as text and as a self-contained HTML page with its charts."""
-        from station.record.render import render_report
+        from station.record.render import render_report  # deferred: it loads numpy
 
         try:
             text = render_report(self.view.path, "txt")
@@ -383,15 +390,14 @@ class SummaryScreen(Screen[None]):
         except StationError as error:
             self.notify(shown_line(explained(error), limit=None), severity="error", markup=False)
             return
-        if self._write(self._export_path(".report.txt"), text, "report"):
-            self._write(self._export_path(".report.html"), page, "HTML report")
+        txt, html = self._export_path(".report.txt"), self._export_path(".report.html")
+        if self._write(txt, text, "report") and self._write(html, page, "HTML report"):
+            # One line, whole: the files are named after the session file (its block above
+            # lists their full paths); a path cut at the screen's edge said nothing.
+            self.notify("Report filed beside the session file, as .report.txt and .report.html")
 
     def action_export_csv(self) -> None:
         """Every cycle as tidy CSV (rejected ones marked) beside the session file."""
-        import io
-
-        from station.session.export import export_csv
-        from station.session.model import load_session
 
         try:
             session = load_session(self.view.path, recover=False)
@@ -400,11 +406,12 @@ class SummaryScreen(Screen[None]):
             return
         buffer = io.StringIO()
         export_csv(session, buffer)
-        self._write(self._export_path(".csv"), buffer.getvalue(), "CSV")
+        target = self._export_path(".csv")
+        if self._write(target, buffer.getvalue(), "CSV"):
+            self.notify("CSV filed beside the session file, as .csv")
 
     def _write(self, target: Path, content: str, what: str) -> bool:
         """Write an export beside the session file; False (and a sentence) when refused."""
-        from station.session.durable import write_text_durably
 
         try:
             # Never through a link planted at the export's name, never over the session file.
@@ -421,11 +428,11 @@ class SummaryScreen(Screen[None]):
             return False
         self.exported.append(f"{what} exported to {target}")
         self._refresh_file()
-        self.notify(shown_line(f"{what} exported to {target}", limit=None), markup=False)
         return True
 
     def action_dashboard(self) -> None:
         """The statistics table and charts of this session, read-only."""
+        # Deferred: a screen loads when first shown.
         from station.tui.screens.dashboard import DashboardScreen, review_view, session_title
 
         header = self.view.header
@@ -460,7 +467,6 @@ class SummaryScreen(Screen[None]):
 
     def action_help(self) -> None:
         """The keys."""
-        from station.tui.screens.dialogs import HelpScreen
 
         self.app.push_screen(HelpScreen())
 

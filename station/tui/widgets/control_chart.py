@@ -1,8 +1,11 @@
 """The control chart drawn in text: points per cycle, centre line, control limits, alarms marked.
 
-It draws the chart the analysis computed (``ControlChart.points``, ``center``, ``ucl``, ``lcl``)
-and the alarms it raised; it computes no limit itself. Points in alarm are drawn as ``✖`` (and in
-red where there is colour), so they read without colour too.
+It draws the chart the analysis computed (``ControlChart.points``) and computes no limit itself.
+While the limits are being estimated (phase I) it draws the chart's own, moving ``center``,
+``ucl`` and ``lcl`` and marks the alarms raised against them; once the limits are frozen (phase
+II: after the first points, or a robot's baseline) it draws the frozen limits the live alarms
+are judged against, and marks those alarms. Points in alarm are drawn as ``✖`` (and in red where
+there is colour), so they read without colour too.
 """
 
 from __future__ import annotations
@@ -14,8 +17,8 @@ from typing import Any
 from rich.text import Text
 from textual.widget import Widget
 
+from station.text import format_figure
 from station.tui.text import shown_line
-from station.tui.widgets.figures import number
 
 _GUTTER = 13  # "UCL +0.00031 " fits; values outside are written in the rows they fall on
 
@@ -31,7 +34,8 @@ class ChartData:
     alarm_points: frozenset[int]
     labels: tuple[int, ...]
     """The cycle number of each point, for the axis."""
-    decimals: int = 5
+    resolution: float | None = None
+    """The gauge's step: the limits are written at one decimal beyond it."""
     title: str = ""
     message: str = ""
     label: str = "cycle"
@@ -46,10 +50,11 @@ def _finite(value: Any) -> float | None:
 
 
 def chart_data(
-    channel: Any, cycle_numbers: list[int] | None, decimals: int, label: str = "cycle"
+    channel: Any, cycle_numbers: list[int] | None, resolution: float | None, label: str = "cycle"
 ) -> ChartData | None:
-    """The drawable part of a channel analysis (``.chart`` and ``.alarms``), or None;
-    ``label`` names the points (``stroke`` for a linearity run's straightness chart)."""
+    """The drawable part of a channel analysis (``.chart`` and ``.alarms``, or once frozen
+    ``.frozen`` and ``.live_alarms``), or None; ``label`` names the points (``stroke`` for a
+    linearity run's straightness chart)."""
     chart = getattr(channel, "chart", None)
     if chart is None:
         # "no readings yet" only when there are none: a single reading has no chart yet.
@@ -63,30 +68,35 @@ def chart_data(
             lcl=None,
             alarm_points=frozenset(),
             labels=(),
-            decimals=decimals,
+            resolution=resolution,
             message=f"control chart: {n} {label} so far, it starts at the 2nd",
             label=label,
         )
     points = tuple(float(p) for p in getattr(chart, "points", ()))
+    # Once frozen, the limits the live alarms are judged against, and those alarms.
+    frozen = getattr(channel, "frozen", None)
+    lines = frozen if frozen is not None else chart
+    alarms = getattr(channel, "live_alarms" if frozen is not None else "alarms", ()) or ()
     alarmed: set[int] = set()
-    for alarm in getattr(channel, "alarms", ()) or ():
+    for alarm in alarms:
         # Alarm points are 1-based positions on the chart.
         alarmed.update(int(p) - 1 for p in getattr(alarm, "points", ()))
     labels = tuple(cycle_numbers[: len(points)]) if cycle_numbers else ()
     if len(labels) != len(points):
         labels = tuple(range(1, len(points) + 1))
+    kind = getattr(chart, "type", "control")
+    name = shown_line(getattr(channel, "name", ""), limit=20)
+    # Short, so "(last 26 of 60)" and the alarm mark's legend still fit beside it.
+    title = f"{kind} {name}, frozen limits" if frozen is not None else f"{kind} chart {name}"
     return ChartData(
         points=points,
-        center=_finite(getattr(chart, "center", None)),
-        ucl=_finite(getattr(chart, "ucl", None)),
-        lcl=_finite(getattr(chart, "lcl", None)),
+        center=_finite(getattr(lines, "center", None)),
+        ucl=_finite(getattr(lines, "ucl", None)),
+        lcl=_finite(getattr(lines, "lcl", None)),
         alarm_points=frozenset(alarmed),
         labels=labels,
-        decimals=decimals,
-        title=(
-            f"{getattr(chart, 'type', 'control')} chart "
-            f"{shown_line(getattr(channel, 'name', ''), limit=20)}"
-        ).strip(),
+        resolution=resolution,
+        title=title.strip(),
         message=str(getattr(chart, "message", "") or ""),
         label=label,
     )
@@ -127,7 +137,7 @@ def render_chart(data: ChartData | None, width: int, height: int) -> Text:
             continue
         row = row_of(value)
         grid[row] = [(char, style)] * plot_width
-        gutter[row] = f"{name} {number(value, data.decimals)}"
+        gutter[row] = f"{name} {format_figure(value, data.resolution)}"
     for offset, value in enumerate(points):
         column = offset * spacing
         alarm = (first + offset) in data.alarm_points

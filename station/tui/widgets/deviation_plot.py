@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from rich.text import Text
 from textual.widget import Widget
 
-from station.tui.widgets.figures import number
+from station.text import format_figure
 
 _GUTTER = 11  # "+0.00123 " fits
 EARLIER = ("·", "blue")
@@ -39,7 +39,8 @@ class DeviationData:
     earlier: tuple[Trace, ...] = ()
     newest: Trace | None = None
     current: Trace | None = None
-    decimals: int = 5
+    resolution: float | None = None
+    """The gauge's step: deviations and positions are written at one decimal beyond it."""
     unit: str = ""
 
 
@@ -82,15 +83,19 @@ def render_deviation(data: DeviationData | None, width: int, height: int) -> Tex
     if data.current is not None:
         legend += " ● now"
     out = [Text(title, style="bold").append(legend[: max(0, width - len(title))], style="dim")]
-    labels = {0: number(peak, data.decimals), rows - 1: number(-peak, data.decimals)}
-    labels.setdefault(zero_row, number(0.0, data.decimals))
+    labels = {
+        0: format_figure(peak, data.resolution),
+        rows - 1: format_figure(-peak, data.resolution),
+    }
+    labels.setdefault(zero_row, format_figure(0.0, data.resolution))
     for row in range(rows):
         line = Text(labels.get(row, "").rjust(_GUTTER - 1) + " ", style="dim")
         line.append("│", style="dim")
         for char, style in grid[row]:
             line.append(char, style=style)
         out.append(line)
-    left, right = f"s {s_low:.2f}", f"{s_high:.2f}"
+    left = f"s {format_figure(s_low, data.resolution, signed=False)}"
+    right = format_figure(s_high, data.resolution, signed=False)
     axis = " " * (_GUTTER + 1) + left
     axis += right.rjust(max(1, width - len(axis)))
     out.append(Text(axis[:width], style="dim"))

@@ -20,9 +20,15 @@ from rich.table import Table
 from rich.text import Text
 from textual.widgets import Static
 
-from station.text import judged_cpk, judged_word
+from station.text import (
+    NOT_AVAILABLE,
+    format_figure,
+    format_index,
+    judged_cpk,
+    judged_word,
+)
 from station.tui.text import shown_line
-from station.tui.widgets.figures import VERDICT_STYLES, number, ratio
+from station.tui.theme import VERDICT_STYLES
 
 OUT_OF_SPEC_MARKS = {"above": "▲", "below": "▼"}
 """How the reading column marks a reading beyond the USL or the LSL (a mark, not a colour)."""
@@ -36,7 +42,8 @@ class StatsRows:
     analyses: Mapping[str, Any] = field(default_factory=dict)
     """Channel -> its ``ChannelAnalysis`` (``descriptive``, ``capability``), or absent."""
     last: Mapping[str, float] = field(default_factory=dict)
-    decimals: int = 5
+    resolution: float | None = None
+    """The gauge's step: every figure is written at one decimal beyond it."""
     unit: str = ""
     selected: str = ""
     flags: Mapping[str, str] = field(default_factory=dict)
@@ -47,24 +54,38 @@ def stats_table(rows: StatsRows) -> Table:
     """A compact rich table, at most 78 cells wide for three channels."""
     # No padding: the box's column dividers are the one-space gaps, so eleven columns (the
     # reading's out-of-spec mark, the out count, a PROVISIONAL or NOT CAPABLE word, a Cpk with
-    # four decimals) fit 76 cells without cutting a figure.
+    # four decimals) fit 76 cells without cutting a figure. Every column is at least as wide as
+    # the figures it can hold at this resolution, so the columns stand still from cycle to
+    # cycle (content-sized columns moved as σ and a₁ appeared).
+    value = len(format_figure(-9.0, rows.resolution))
     table = Table(box=box.SIMPLE_HEAD, padding=(0, 0), pad_edge=False, show_edge=False, expand=True)
     table.add_column("", width=3, no_wrap=True)
-    for heading in ("reading", "n", "X̄", "σ", "a₁", "range", "Cp", "Cpk", "out"):
-        table.add_column(heading, justify="right", no_wrap=True)
+    widths = {
+        "reading": value + 1,  # the ▲/▼ mark
+        "n": 3,
+        "X̄": value,
+        "σ": value - 1,
+        "a₁": len("-0.00"),
+        "range": value - 1,
+        "Cp": len("1.00"),
+        "Cpk": len("0.9996"),
+        "out": 3,
+    }
+    for heading, width in widths.items():
+        table.add_column(heading, justify="right", no_wrap=True, min_width=width)
     table.add_column("verdict", no_wrap=True, min_width=11)
     provisional = []
     for channel in rows.channels:
         analysis = rows.analyses.get(channel)
         descriptive = getattr(analysis, "descriptive", None)
         capability = getattr(analysis, "capability", None)
-        word = judged_word(analysis) if analysis is not None else "—"
+        word = judged_word(analysis) if analysis is not None else NOT_AVAILABLE
         verdict = getattr(analysis, "verdict", None)
         if verdict is not None and verdict.provisional:
             provisional.append(verdict)
         marker = "▶" if channel == rows.selected else " "
         flag = rows.flags.get(channel)
-        reading = Text(number(rows.last.get(channel), rows.decimals))
+        reading = Text(format_figure(rows.last.get(channel), rows.resolution))
         reading.append(OUT_OF_SPEC_MARKS.get(flag or "", " "), style="bold red")
         if flag:
             reading.stylize("bold red")
@@ -74,12 +95,12 @@ def stats_table(rows: StatsRows) -> Table:
             Text(f"{marker}{shown_line(channel, limit=20)}", style="bold"),
             reading,
             str(getattr(descriptive, "n", 0)),
-            number(getattr(descriptive, "mean", None), rows.decimals),
-            number(getattr(descriptive, "sd", None), rows.decimals, signed=False),
-            ratio(getattr(descriptive, "skewness", None)),
-            number(getattr(descriptive, "range", None), rows.decimals, signed=False),
-            ratio(getattr(capability, "cp", None)),
-            judged_cpk(analysis) if analysis is not None else ratio(None),
+            format_figure(getattr(descriptive, "mean", None), rows.resolution),
+            format_figure(getattr(descriptive, "sd", None), rows.resolution, signed=False),
+            format_index(getattr(descriptive, "skewness", None)),
+            format_figure(getattr(descriptive, "range", None), rows.resolution, signed=False),
+            format_index(getattr(capability, "cp", None)),
+            judged_cpk(analysis) if analysis is not None else NOT_AVAILABLE,
             Text(str(out), style="bold red" if out else "dim"),
             Text(word, style=VERDICT_STYLES.get(word, "")),
         )

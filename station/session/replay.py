@@ -1,0 +1,437 @@
+"""Replay: the one place that knows what a valid header and a valid event are.
+
+:class:`Replay` checks each record of a session file in order and accumulates what they add up
+to: the cycles and their readings, rejects, notes, alarms, inputs, streamed points and the
+session's status. The writer checks every event with it before writing, and the loader replays
+a file with it, so a file the writer produced always loads. The table :data:`_EVENT_CHECKS`
+holds one check per event type. Like the model, it loads numpy only when arrays are asked for
+(:meth:`SampleBatch.as_arrays`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Literal
+
+from station.session.lines import FORMAT, line_hash
+
+if TYPE_CHECKING:
+    import numpy as np
+
+EVENT_TYPES: tuple[str, ...] = (
+    "step",
+    "input",
+    "zero",
+    "reading",
+    "reject",
+    "note",
+    "alarm",
+    "ack",
+    "instrument",
+    "samples",
+    "resume",
+    "interrupted",
+    "finish",
+)
+RESERVED_FIELDS: frozenset[str] = frozenset({"seq", "t", "type", "prev", "hash"})
+"""Fields the journal sets itself; an event cannot carry them."""
+HEADER_REQUIRED: tuple[str, ...] = ("robot", "procedure", "channels", "unit")
+"""Header fields the caller of ``SessionWriter.create`` must give."""
+
+Status = Literal["running", "interrupted", "finished"]
+
+
+@dataclass(frozen=True)
+class ChannelReading:
+    """One channel of one cycle: the zeroed value and how it was obtained."""
+
+    value: float
+    """The value the analysis uses: the device value minus the zero offset."""
+    unit: str
+    raw_value: float | None = None
+    """The value the device sent (before the software zero offset)."""
+    zero: float | None = None
+    """The software zero offset subtracted, or None when the device was zeroed by command."""
+    raw: str = ""
+    """The frame text as received."""
+    t_wall: float | None = None
+    t_mono: float | None = None
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """One recorded cycle: a reading set, one value per channel the step captures."""
+
+    number: int
+    seq: int
+    t: str
+    step: str
+    readings: Mapping[str, ChannelReading]
+    placement: int | None = None
+    """The repeat-block iteration (fixture placement) the cycle belongs to, when any."""
+
+
+@dataclass(frozen=True)
+class SampleBatch:
+    """One ``samples`` event: streamed points of one stroke, one row per point."""
+
+    seq: int
+    step: str
+    stroke: int | None
+    channels: tuple[str, ...]
+    values: tuple[tuple[float, ...], ...]
+    t_mono: tuple[float, ...] = ()
+
+    def as_arrays(self) -> dict[str, np.ndarray]:
+        """The points as one array per channel."""
+        import numpy as np
+
+        table = np.asarray(self.values, dtype=float).reshape(len(self.values), len(self.channels))
+        return {channel: table[:, index] for index, channel in enumerate(self.channels)}
+
+
+def _is_number(value: Any) -> bool:
+    if not isinstance(value, int | float) or isinstance(value, bool):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:  # an integer too large for a float
+        return False
+
+
+READING_LIMIT = 1e150
+"""The largest magnitude a recorded value or limit may have, in a session file or a CSV table:
+squares and sums of ten million of them stay finite floats (a 1e308 would overflow the mean and
+sigma into nonsense)."""
+CYCLE_LIMIT = 2**53
+"""Cycle numbers stay exact as floats and fit every integer array."""
+COUNT_LIMIT = 1_000_000
+"""The largest cycle, placement or stroke target a header may ask for."""
+
+
+def _is_reading(value: Any) -> bool:
+    return _is_number(value) and abs(value) <= READING_LIMIT
+
+
+def _optional_number(value: Any) -> float | None:
+    return float(value) if _is_number(value) else None
+
+
+@dataclass
+class Replay:
+    """Accumulates a session's header and events, checking each one.
+
+    :meth:`check` raises ``ValueError`` with the fault (the caller adds file and line);
+    :meth:`apply` adds a checked record. The writer checks an event before writing it, so what
+    it writes always replays.
+    """
+
+    header: dict[str, Any] = field(default_factory=dict)
+    events: list[dict[str, Any]] = field(default_factory=list)
+    cycles: dict[int, Cycle] = field(default_factory=dict)
+    rejected: dict[int, str] = field(default_factory=dict)
+    notes: list[dict[str, Any]] = field(default_factory=list)
+    alarms: list[dict[str, Any]] = field(default_factory=list)
+    acks: list[dict[str, Any]] = field(default_factory=list)
+    inputs: dict[str, dict[str, Any]] = field(default_factory=dict)
+    input_events: list[dict[str, Any]] = field(default_factory=list)
+    zeroes: list[dict[str, Any]] = field(default_factory=list)
+    samples: list[SampleBatch] = field(default_factory=list)
+    confirmed_steps: list[str] = field(default_factory=list)
+    status: Status = "running"
+    last_seq: int = 0
+    last_hash: str | None = None
+    """The last line's own ``hash`` field: the anchor printed on summaries and reports."""
+    chain_hash: str | None = None
+    """The sha256 of the last line's bytes: the next line's ``prev``."""
+    checks_only: bool = False
+    """A writer's replay: keep what checking the next event needs (the header, the cycle numbers,
+    rejects, alarms, inputs), not every event's record, its readings or its streamed points, so
+    a long session's memory stays small (the file keeps everything)."""
+
+    def keep_checks_only(self) -> None:
+        """Drop what only a reader of the whole session needs (see :attr:`checks_only`)."""
+        self.checks_only = True
+        self.events.clear()
+        self.samples.clear()
+        self.notes.clear()
+        self.input_events.clear()
+
+    def check(self, record: Mapping[str, Any]) -> None:
+        """Raise ValueError naming the fault when ``record`` cannot come next."""
+        if not self.header:
+            _check_header(record)
+            return
+        if "format" in record:
+            raise ValueError("a second header in the middle of the file")
+        if self.status == "finished":
+            raise ValueError(
+                "an event after the session's finish (a finished session holds nothing more; "
+                "the line was added later)"
+            )
+        seq = record.get("seq")
+        if not isinstance(seq, int) or isinstance(seq, bool):
+            raise ValueError("the event has no integer 'seq'")
+        if seq != self.last_seq + 1:
+            raise ValueError(f"seq {seq} out of order (expected {self.last_seq + 1})")
+        if not isinstance(record.get("t"), str):
+            raise ValueError("the event has no time 't'")
+        kind = record.get("type")
+        if kind not in EVENT_TYPES:
+            raise ValueError(f"unknown event type {kind!r}")
+        _EVENT_CHECKS[kind](self, record)
+
+    def apply(self, record: dict[str, Any], line: bytes) -> None:
+        """Add a checked record; ``line`` is its bytes on disk (for the chain)."""
+        self.chain_hash = line_hash(line)
+        self.last_hash = str(record["hash"])
+        if not self.header:
+            self.header = record
+            return
+        if not self.checks_only:
+            self.events.append(record)
+        self.last_seq = record["seq"]
+        kind = record["type"]
+        if kind == "reading" and self.checks_only:
+            # Checking later events needs the cycle's number, not its values.
+            self.cycles[record["cycle"]] = Cycle(
+                number=record["cycle"], seq=record["seq"], t=record["t"], step="", readings={}
+            )
+        elif kind == "reading":
+            readings = {
+                channel: ChannelReading(
+                    value=float(spec["value"]),
+                    unit=str(spec.get("unit") or self.header["unit"]),
+                    raw_value=_optional_number(spec.get("raw_value")),
+                    zero=_optional_number(spec.get("zero")),
+                    raw=str(spec.get("raw", "")),
+                    t_wall=_optional_number(spec.get("t_wall")),
+                    t_mono=_optional_number(spec.get("t_mono")),
+                )
+                for channel, spec in record["channels"].items()
+            }
+            placement = record.get("placement")
+            self.cycles[record["cycle"]] = Cycle(
+                number=record["cycle"],
+                seq=record["seq"],
+                t=record["t"],
+                step=str(record.get("step", "")),
+                readings=readings,
+                placement=placement if isinstance(placement, int) else None,
+            )
+        elif kind == "reject":
+            self.rejected[record["cycle"]] = record["reason"]
+        elif kind == "note" and not self.checks_only:
+            self.notes.append(record)
+        elif kind == "alarm":
+            self.alarms.append(record)
+        elif kind == "ack":
+            self.acks.append(record)
+        elif kind == "input":
+            self.inputs[record["step"]] = record["values"]
+            if not self.checks_only:
+                self.input_events.append(record)
+        elif kind == "zero":
+            self.zeroes.append(record)
+        elif kind == "samples" and not self.checks_only:
+            stroke = record.get("stroke")
+            self.samples.append(
+                SampleBatch(
+                    seq=record["seq"],
+                    step=record["step"],
+                    stroke=stroke if isinstance(stroke, int) else None,
+                    channels=tuple(record["channels"]),
+                    values=tuple(tuple(float(v) for v in row) for row in record["values"]),
+                    t_mono=tuple(float(v) for v in record.get("t_mono") or ()),
+                )
+            )
+        elif kind == "step":
+            if record["action"] == "confirmed" and record["step"] not in self.confirmed_steps:
+                self.confirmed_steps.append(record["step"])
+        elif kind == "finish":
+            self.status = "finished"
+        elif kind == "interrupted":
+            self.status = "interrupted"
+        elif kind == "resume":
+            self.status = "running"
+
+
+def _check_header(record: Mapping[str, Any]) -> None:
+    if record.get("format") != FORMAT:
+        raise ValueError(f"not a station session header (format {record.get('format')!r})")
+    for key in ("session", "created", "robot", "unit"):
+        if not isinstance(record.get(key), str):
+            raise ValueError(f"the header has no text {key!r}")
+    procedure = record.get("procedure")
+    if not isinstance(procedure, dict) or not all(
+        isinstance(procedure.get(key), str) for key in ("id", "version", "sha256")
+    ):
+        raise ValueError("the header's 'procedure' needs text 'id', 'version' and 'sha256'")
+    channels = record.get("channels")
+    if (
+        not isinstance(channels, list)
+        or not channels
+        or not all(isinstance(c, str) and c for c in channels)
+        or len(set(channels)) != len(channels)
+    ):
+        raise ValueError("the header's 'channels' must be a list of distinct names")
+    limits = record.get("limits", {})
+    if limits is not None and not isinstance(limits, dict):
+        raise ValueError("the header's 'limits' must be a table")
+    for channel, spec in (limits or {}).items():
+        if not isinstance(spec, dict):
+            raise ValueError(f"the header's limits of {channel!r} must be a table")
+        for key in ("lsl", "usl", "nominal"):
+            if spec.get(key) is not None and not _is_reading(spec[key]):
+                raise ValueError(
+                    f"the header's {key} of {channel!r} must be a finite number within "
+                    f"±{READING_LIMIT:g}"
+                )
+    for key in ("resolution", "threshold"):
+        value = record.get(key)
+        if value is not None and not (_is_reading(value) and value > 0):
+            raise ValueError(f"the header's {key!r} must be a number above 0")
+    for key in ("cycles_target", "placements_target", "strokes_target"):
+        value = record.get(key)
+        if value is not None and not (
+            isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= COUNT_LIMIT
+        ):
+            raise ValueError(f"the header's {key!r} must be a whole number from 1 to {COUNT_LIMIT}")
+    if record.get("rules") is not None and not isinstance(record.get("rules"), str):
+        raise ValueError("the header's 'rules' must be text")
+    signer = record.get("signer")
+    if signer is not None and not (
+        isinstance(signer, dict)
+        and isinstance(signer.get("key"), str)
+        and isinstance(signer.get("public_key"), str)
+    ):
+        raise ValueError("the header's 'signer' needs text 'key' and 'public_key'")
+    if record.get("prev", "missing") is not None:
+        raise ValueError("the header's 'prev' must be null")
+
+
+def _need_text(record: Mapping[str, Any], key: str) -> str:
+    value = record.get(key)
+    if not isinstance(value, str) or not value:
+        raise ValueError(f"a {record['type']} event needs text {key!r}")
+    return value
+
+
+def _need_cycle(record: Mapping[str, Any]) -> int:
+    cycle = record.get("cycle")
+    if not isinstance(cycle, int) or isinstance(cycle, bool) or not 1 <= cycle <= CYCLE_LIMIT:
+        raise ValueError(f"a {record['type']} event needs a cycle number from 1 to {CYCLE_LIMIT}")
+    return cycle
+
+
+def _check_step(replay: Replay, record: Mapping[str, Any]) -> None:
+    _need_text(record, "step")
+    _need_text(record, "action")
+
+
+def _check_input(replay: Replay, record: Mapping[str, Any]) -> None:
+    _need_text(record, "step")
+    if not isinstance(record.get("values"), dict):
+        raise ValueError("an input event needs a table 'values'")
+
+
+def _check_zero(replay: Replay, record: Mapping[str, Any]) -> None:
+    channels = record.get("channels")
+    if not isinstance(channels, dict) or not channels:
+        raise ValueError("a zero event needs a table 'channels'")
+    for channel, spec in channels.items():
+        if channel not in replay.header["channels"]:
+            raise ValueError(f"a zero event names channel {channel!r}, not in the session")
+        if not isinstance(spec, dict):
+            raise ValueError(f"a zero event's channel {channel!r} must be a table")
+
+
+def _check_reading(replay: Replay, record: Mapping[str, Any]) -> None:
+    cycle = _need_cycle(record)
+    if cycle in replay.cycles:
+        raise ValueError(f"cycle {cycle} is recorded twice (seq {replay.cycles[cycle].seq})")
+    channels = record.get("channels")
+    if not isinstance(channels, dict) or not channels:
+        raise ValueError("a reading event needs a table 'channels'")
+    for channel, spec in channels.items():
+        if channel not in replay.header["channels"]:
+            raise ValueError(f"a reading names channel {channel!r}, not in the session")
+        if not isinstance(spec, dict) or not _is_reading(spec.get("value")):
+            raise ValueError(
+                f"a reading's channel {channel!r} needs a number 'value' within ±{READING_LIMIT:g}"
+            )
+
+
+def _check_reject(replay: Replay, record: Mapping[str, Any]) -> None:
+    cycle = _need_cycle(record)
+    if cycle not in replay.cycles:
+        raise ValueError(f"a reject names cycle {cycle}, which was never recorded")
+    _need_text(record, "reason")
+
+
+def _check_note(replay: Replay, record: Mapping[str, Any]) -> None:
+    _need_text(record, "text")
+
+
+def _check_samples(replay: Replay, record: Mapping[str, Any]) -> None:
+    _need_text(record, "step")
+    channels = record.get("channels")
+    if (
+        not isinstance(channels, list)
+        or not channels
+        or not all(isinstance(c, str) and c in replay.header["channels"] for c in channels)
+    ):
+        raise ValueError("a samples event needs 'channels', a list of the session's channels")
+    values = record.get("values")
+    if not isinstance(values, list) or not all(
+        isinstance(row, list) and len(row) == len(channels) and all(map(_is_reading, row))
+        for row in values
+    ):
+        raise ValueError("a samples event needs 'values', rows of one number per channel")
+    t_mono = record.get("t_mono")
+    if t_mono is not None and (
+        not isinstance(t_mono, list)
+        or len(t_mono) != len(values)
+        or not all(map(_is_number, t_mono))
+    ):
+        raise ValueError("a samples event's 't_mono' must hold one number per row")
+
+
+def _check_ack(replay: Replay, record: Mapping[str, Any]) -> None:
+    """An acknowledgement: ``alarm`` (the seq of a recorded alarm event), ``cause`` (one of the
+    procedure's causes), ``text`` (required when the cause is "other"), ``action`` (optional
+    corrective action)."""
+    alarm = record.get("alarm")
+    if not isinstance(alarm, int) or isinstance(alarm, bool):
+        raise ValueError("an ack event needs 'alarm', the seq of the alarm it acknowledges")
+    if not any(event["seq"] == alarm for event in replay.alarms):
+        raise ValueError(f"an ack names alarm {alarm}, which is not a recorded alarm event")
+    cause = _need_text(record, "cause")
+    for key in ("text", "action", "by"):
+        if key in record and not isinstance(record[key], str):
+            raise ValueError(f"an ack event's {key!r} must be text")
+    if cause == "other" and not str(record.get("text") or "").strip():
+        raise ValueError("an ack with the cause 'other' needs a 'text' saying what it was")
+
+
+def _check_free(replay: Replay, record: Mapping[str, Any]) -> None:
+    """Events whose fields are free-form (alarm, instrument, resume, interrupted, finish)."""
+
+
+_EVENT_CHECKS = {
+    "step": _check_step,
+    "input": _check_input,
+    "zero": _check_zero,
+    "reading": _check_reading,
+    "reject": _check_reject,
+    "note": _check_note,
+    "alarm": _check_free,
+    "ack": _check_ack,
+    "instrument": _check_free,
+    "samples": _check_samples,
+    "resume": _check_free,
+    "interrupted": _check_free,
+    "finish": _check_free,
+}
