@@ -83,7 +83,7 @@ def _pooled(inputs: KindInputs, channels: Sequence[str], config: Any) -> Analysi
         cycles=cycles,
         times=times,
     )
-    return replace(analysis, hints=())
+    return replace(analysis, given_hints=())
 
 
 def fitted(lines: Sequence[str], width: int) -> tuple[str, ...]:

@@ -26,14 +26,13 @@ from typing import Any
 
 import numpy as np
 
+from station.analysis.document import channel_to_json, json_number
 from station.analysis.summary import (
     Analysis,
     AnalysisConfig,
     ChannelAnalysis,
-    _number,
     analyze,
     analyze_channel,
-    channel_to_json,
 )
 from station.errors import StationError
 
@@ -171,12 +170,12 @@ def accuracy_json(result: AccuracyAnalysis) -> dict[str, Any]:
     return {
         "axes": {
             axis: {
-                "average": _number(result.average[axis]),
-                "spread": _number(result.spread[axis]),
-                "range": _number(result.span[axis]),
+                "average": json_number(result.average[axis]),
+                "spread": json_number(result.spread[axis]),
+                "range": json_number(result.span[axis]),
                 "scale_error": None
                 if result.scale_error is None
-                else _number(result.scale_error[axis]),
+                else json_number(result.scale_error[axis]),
             }
             for axis in AXES
         },
@@ -186,16 +185,16 @@ def accuracy_json(result: AccuracyAnalysis) -> dict[str, Any]:
                 "n": p.n,
                 "pendant": None
                 if p.pendant is None
-                else {axis: _number(v) for axis, v in zip(AXES, p.pendant, strict=True)},
-                "distance": _number(p.distance),
-                "mean": {axis: _number(v) for axis, v in p.mean.items()},
-                "sd": {axis: _number(v) for axis, v in p.sd.items()},
-                "error_3d": _number(p.error_3d),
+                else {axis: json_number(v) for axis, v in zip(AXES, p.pendant, strict=True)},
+                "distance": json_number(p.distance),
+                "mean": {axis: json_number(v) for axis, v in p.mean.items()},
+                "sd": {axis: json_number(v) for axis, v in p.sd.items()},
+                "error_3d": json_number(p.error_3d),
             }
             for p in result.placements
         ],
         "error_3d": channel_to_json(result.error_3d),
         "per_unit": None
         if result.per_unit is None
-        else [[_number(v) for v in row] for row in result.per_unit],
+        else [[json_number(v) for v in row] for row in result.per_unit],
     }

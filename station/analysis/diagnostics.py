@@ -27,16 +27,15 @@ Definitions and sources: ``reference/spc-extensions.md`` §3–§5.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+
+import numpy as np
 
 from station.analysis.capability import SpecLimits
 from station.analysis.descriptive import as_readings
 from station.text import format_figure
-
-if TYPE_CHECKING:
-    import numpy as np
 
 #: Significance level of the normality, autocorrelation and trend tests.
 ALPHA = 0.05
@@ -79,7 +78,6 @@ def out_of_spec(
 ) -> OutOfSpec:
     """The readings below the LSL and above the USL (strictly), named by ``cycles`` (1, 2, 3 ...
     when None). Without limits nothing is out of specification."""
-    import numpy as np
 
     array = as_readings(values)
     labels = np.arange(1, array.size + 1) if cycles is None else np.asarray(cycles, dtype=int)
@@ -135,7 +133,6 @@ def normality(
     alpha: float = ALPHA,
 ) -> Normality:
     """Shapiro–Wilk (n ≤ 5000) or Anderson–Darling (larger n) test of normality."""
-    import numpy as np
     from scipy import stats
 
     array = as_readings(values)
@@ -156,8 +153,6 @@ def normality(
             "readings make the test reject normal data more often"
         )
     if n <= SHAPIRO_MAX_N:
-        import warnings
-
         with warnings.catch_warnings():
             # A spread at the last digits of a float ("range zero") still has a p-value.
             warnings.simplefilter("ignore", UserWarning)
@@ -192,7 +187,6 @@ class PercentileCapability:
 
 
 def _quantiles(array: np.ndarray) -> tuple[str, tuple[float, float, float]]:
-    import numpy as np
     from scipy import stats
 
     levels = [LOWER_QUANTILE, 0.5, UPPER_QUANTILE]
@@ -211,7 +205,6 @@ def percentile_capability(
     values: Iterable[float] | np.ndarray, limits: SpecLimits, threshold: float = 1.0
 ) -> PercentileCapability | None:
     """The percentile indices of the readings (None with fewer than 3 readings or no spread)."""
-    import numpy as np
 
     array = as_readings(values)
     if array.size < 3 or not float(np.ptp(array)) > 0:
@@ -270,7 +263,6 @@ AUTOCORRELATION_EXPLANATION = (
 
 def lag1(array: np.ndarray) -> float | None:
     """r₁ of an array (None without spread)."""
-    import numpy as np
 
     deviations = array - array.mean()
     # Products summed by numpy rather than np.dot: BLAS threads on a shared, loaded machine
@@ -287,7 +279,6 @@ def autocorrelation(
     sigma_within: float | None = None,
 ) -> Autocorrelation:
     """Lag-1 autocorrelation and its significance (see the module docstring)."""
-    import numpy as np
     from scipy.special import ndtr
 
     array = as_readings(values)
@@ -356,7 +347,6 @@ def ewma_values(
 ) -> np.ndarray:
     """z_i = λx_i + (1 − λ)z_{i−1} with z_0 = ``center``, in one pass of ``scipy.signal.lfilter``
     (direct form: y[n] = b₀x[n] − a₁y[n−1], initial state (1 − λ)·z₀)."""
-    import numpy as np
     from scipy.signal import lfilter
 
     x = np.asarray(points, dtype=float)
@@ -383,7 +373,6 @@ def ewma_chart(
     """The EWMA of the readings about ``center`` with limits from ``sigma`` (the within sigma)."""
     if not 0 < lam <= 1:
         raise ValueError("the EWMA weight must lie in (0, 1]")
-    import numpy as np
 
     array = as_readings(values)
     labels = np.arange(1, array.size + 1) if cycles is None else np.asarray(cycles, dtype=int)
@@ -430,7 +419,6 @@ def trend(
     confidence: float = 0.95,
 ) -> Trend:
     """The trend of the readings (see :class:`Trend`); ``times`` in seconds, one per reading."""
-    import numpy as np
     from scipy import stats
 
     array = as_readings(values)
@@ -482,7 +470,6 @@ def drift(
 ) -> Drift:
     """EWMA about the mean (σ the within sigma) and the trend on reading times; the trend in
     the message is written at the gauge ``resolution``'s figure decimals when given."""
-    import numpy as np
 
     array = as_readings(values)
     chart = None
@@ -505,3 +492,12 @@ def drift(
             "during the session; look for warm-up, a loose fixture or gauge, and repeat"
         )
     return Drift(chart, found, message)
+
+
+def import_scipy() -> None:
+    """Import the parts of scipy the analysis loads where it uses them (a screen that imports
+    the analysis does not wait for scipy): call it on a worker thread early, so that the first
+    use does not import it where waiting costs (an engine's intake, under its lock)."""
+    import scipy.signal  # noqa: F401 - the EWMA (diagnostics)
+    import scipy.special  # noqa: F401 - the confidence bounds (capability, constants, hints)
+    import scipy.stats  # noqa: F401 - the tests (diagnostics, gauge check, joints)

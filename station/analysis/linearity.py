@@ -37,6 +37,8 @@ from typing import Any
 import numpy as np
 
 from station.analysis.capability import SpecLimits
+from station.analysis.document import channel_to_json
+from station.analysis.document import json_number as _number
 from station.analysis.strokes import (
     DIRECTIONS,
     StrokeProfile,
@@ -45,9 +47,7 @@ from station.analysis.summary import (
     Analysis,
     AnalysisConfig,
     ChannelAnalysis,
-    _number,
     analyze_channel,
-    channel_to_json,
 )
 from station.errors import StationError
 from station.text import format_figure
@@ -531,8 +531,8 @@ def linearity_summary(result: LinearityAnalysis) -> Analysis:
     return Analysis(
         channels=named,
         spatial=None,
-        hints=linearity_hints(result),
         config=result.config,
+        given_hints=linearity_hints(result),
     )
 
 

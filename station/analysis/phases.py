@@ -3,7 +3,7 @@
 Phase I estimates the limits from a first set of points and judges them retrospectively: a point
 can change status as data arrive. Phase II fixes the limits (frozen after the first k points, or
 taken from a baseline) and judges each new point against them, so a signal never disappears.
-Live alarms are phase II: :class:`~station.analysis.live.LiveMonitor` raises them as readings
+Live alarms are phase II: :class:`~station.analysis.monitor.LiveMonitor` raises them as readings
 arrive, and :func:`phase_two_alarms` gives the same set over all points in one pass.
 
 Beside the run rules, phase II watches the mean with an EWMA about the frozen centre line

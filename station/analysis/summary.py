@@ -2,7 +2,8 @@
 
 :func:`analyze` runs the report's statistics on every channel (descriptive figures, histogram,
 capability, control chart and run rules), the 3-D figures when channels x, y and z are present,
-and the verdict hints. :func:`to_json` turns the result into the documented JSON document.
+and the verdict hints. :func:`station.analysis.document.to_json` turns the result into the
+documented JSON document.
 
 Run rules are checked on the location chart (individuals or subgroup means) against its own
 centre line and sigma, ``(UCL − centre)/3``; the dispersion chart's limits are reported, not
@@ -18,7 +19,6 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any
 
 import numpy as np
 
@@ -45,7 +45,7 @@ from station.analysis.phases import (
     FrozenLimits,
     phase_two_alarms,
 )
-from station.analysis.rules import RULE_SETS, Alarm, check_rules, rule_name
+from station.analysis.rules import RULE_SETS, Alarm, check_rules
 from station.analysis.spatial import AXES, Spatial, find_axes, spatial_figures
 from station.analysis.verdict import DEFAULT_MIN_N, Verdict, judge_verdict
 from station.errors import StationError
@@ -201,9 +201,20 @@ class Analysis:
 
     channels: dict[str, ChannelAnalysis]
     spatial: Spatial | None
-    hints: tuple[str, ...]
     config: AnalysisConfig
     excluded_cycles: tuple[int, ...] = ()
+    given_hints: tuple[str, ...] | None = None
+    """The hints of an analysis built with its own (a linearity summary's; none for a kind
+    whose report block says what its figures point to); None: the channels' hints."""
+
+    @cached_property
+    def hints(self) -> tuple[str, ...]:
+        """The verdict hints: :attr:`given_hints`, else every channel's (:func:`hints_of`).
+        Worked out on first use: the hint on non-normal readings fits a distribution (tens of
+        ms a channel), too slow for every live snapshot of a screen that shows no hints."""
+        if self.given_hints is not None:
+            return self.given_hints
+        return hints_of(list(self.channels.values()), self.config)
 
     @property
     def incapable_channels(self) -> list[str]:
@@ -516,229 +527,6 @@ def combine(
     return Analysis(
         channels=dict(channels),
         spatial=spatial_of(readings, config),
-        hints=hints_of(list(channels.values()), config),
         config=config,
         excluded_cycles=tuple(excluded_cycles),
     )
-
-
-def _number(value: float | None) -> float | None:
-    """A JSON number, or None for undefined (never NaN or inf)."""
-    if value is None:
-        return None
-    value = float(value)
-    return value if np.isfinite(value) else None
-
-
-def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
-    """One channel of the JSON document."""
-    d, cap, chart = channel.descriptive, channel.capability, channel.chart
-    verdict = channel.verdict
-    return {
-        "n": d.n,
-        "mean": _number(d.mean),
-        "sd": _number(d.sd),
-        "skewness": _number(d.skewness),
-        "mode": [_number(m) for m in d.modes],
-        "min": _number(d.min),
-        "max": _number(d.max),
-        "range": _number(d.range),
-        "nominal": _number(channel.nominal),
-        # Absent when the readings are cycles 1 to n in order (a million-row CSV would
-        # otherwise print a million numbers that say nothing).
-        **({} if _numbered_in_order(channel.cycles) else {"cycles": list(channel.cycles)}),
-        "capability": {
-            "lsl": _number(cap.lsl),
-            "usl": _number(cap.usl),
-            "cp": _number(cap.cp),
-            "cpu": _number(cap.cpu),
-            "cpl": _number(cap.cpl),
-            "cpk": _number(cap.cpk),
-            "cpk_lower": _number(cap.cpk_lower),
-            "cp_within": _number(cap.cp_within),
-            "cpk_within": _number(cap.cpk_within),
-            "sigma": _number(cap.sigma),
-            "sigma_within": _number(cap.sigma_within),
-            "threshold": _number(cap.threshold),
-            "capable": cap.capable,
-            "above_usl": cap.above_usl,
-            "below_lsl": cap.below_lsl,
-            "message": cap.message,
-            "provisional": verdict.provisional if verdict else False,
-            "min_n": verdict.min_n if verdict else None,
-            "verdict": verdict.label if verdict else None,
-            "verdict_text": verdict.text if verdict else None,
-            "method": channel.capability_method,
-            "percentile": _percentile_json(channel.percentile),
-        },
-        "out_of_spec": _out_of_spec_json(channel),
-        "normality": _normality_json(channel.normality),
-        "autocorrelation": _autocorrelation_json(channel.autocorrelation),
-        "drift": _drift_json(channel.drift),
-        "phase_two": None
-        if channel.frozen is None
-        else {
-            "center": _number(channel.frozen.center),
-            "ucl": _number(channel.frozen.ucl),
-            "lcl": _number(channel.frozen.lcl),
-            "source": channel.frozen.source,
-        },
-        "live_alarms": [_alarm_json(a, True) for a in channel.live_alarms],
-        "chart": {
-            "type": chart.type,
-            "subgroup": chart.subgroup,
-            "center": _number(chart.center),
-            "ucl": _number(chart.ucl),
-            "lcl": _number(chart.lcl),
-            "sigma_within": _number(chart.sigma_within),
-            "dispersion": {
-                "center": _number(chart.dispersion.center),
-                "ucl": _number(chart.dispersion.ucl),
-                "lcl": _number(chart.dispersion.lcl),
-            },
-            "message": chart.message,
-        },
-        "alarms": [_alarm_json(a, channel.alarm_is_live(a)) for a in channel.alarms],
-    }
-
-
-def _alarm_json(alarm: Alarm, live: bool) -> dict[str, Any]:
-    return {
-        "rule": alarm.rule,
-        "rule_name": rule_name(alarm.rule),
-        "points": list(alarm.points),
-        "cycles": list(alarm.cycles),
-        "text": alarm.text,
-        "live": live,
-    }
-
-
-def _percentile_json(result: PercentileCapability | None) -> dict[str, Any] | None:
-    if result is None:
-        return None
-    return {
-        "method": result.method,
-        "q_0_135": _number(result.q_low),
-        "median": _number(result.median),
-        "q_99_865": _number(result.q_high),
-        "pp": _number(result.pp),
-        "ppu": _number(result.ppu),
-        "ppl": _number(result.ppl),
-        "ppk": _number(result.ppk),
-        "capable": result.capable,
-    }
-
-
-def _out_of_spec_json(channel: ChannelAnalysis) -> dict[str, Any]:
-    found = channel.out_of_spec
-    if found is None:
-        return {"below": 0, "above": 0, "cycles": []}
-    return {
-        "below": found.below,
-        "above": found.above,
-        "cycles": list(found.cycles),
-        "cycles_below": list(found.cycles_below),
-        "cycles_above": list(found.cycles_above),
-    }
-
-
-def _normality_json(result: Normality | None) -> dict[str, Any] | None:
-    if result is None:
-        return None
-    return {
-        "test": result.test,
-        "statistic": _number(result.statistic),
-        "p": _number(result.p_value),
-        "alpha": result.alpha,
-        "rejected": result.rejected,
-        "ties": result.ties,
-        "message": result.message,
-    }
-
-
-def _autocorrelation_json(result: Autocorrelation | None) -> dict[str, Any] | None:
-    if result is None:
-        return None
-    return {
-        "lag1": _number(result.r1),
-        "z": _number(result.z),
-        "p": _number(result.p_value),
-        "alpha": result.alpha,
-        "significant": result.significant,
-        "sigma_ratio": _number(result.sigma_ratio),
-        "message": result.message,
-    }
-
-
-def _drift_json(result: Drift | None) -> dict[str, Any] | None:
-    if result is None:
-        return None
-    found = result.trend
-    ewma = result.ewma
-    return {
-        "trend": {
-            "basis": found.basis,
-            "span_cycles": found.span,
-            "per_span": _number(found.per_span),
-            "low": _number(found.low),
-            "high": _number(found.high),
-            "p": _number(found.p_value),
-            "significant": found.significant,
-            "cycle_seconds": _number(found.cycle_seconds),
-        },
-        "ewma": None
-        if ewma is None
-        else {
-            "lambda": ewma.lam,
-            "width": ewma.width,
-            "center": _number(ewma.center),
-            "sigma": _number(ewma.sigma),
-            "signal_cycles": list(ewma.signal_cycles),
-        },
-        "message": result.message,
-    }
-
-
-def spatial_to_json(spatial: Spatial) -> dict[str, Any]:
-    """The 3-D figures of the JSON document."""
-    return {
-        "n": spatial.n,
-        "nominal": {axis: _number(v) for axis, v in spatial.nominal.items()},
-        "offset": {axis: _number(v) for axis, v in spatial.offset.items()},
-        "total_offset": _number(spatial.total_offset),
-        "ap": {key: _number(v) for key, v in spatial.ap.items()},
-        "rp": _number(spatial.rp),
-        "l_mean": _number(spatial.l_mean),
-        "l_sd": _number(spatial.l_sd),
-        "message": spatial.message,
-    }
-
-
-def to_json(analysis: Analysis) -> dict[str, Any]:
-    """The JSON document of `station analyze --json` (undefined values are None → null).
-
-    ``spatial`` is always present: an object when channels x, y, z exist, else null.
-    """
-    config = analysis.config
-    return {
-        "unit": config.unit,
-        "resolution": _number(config.resolution),
-        "subgroup": config.subgroup,
-        "rules": config.rule_set,
-        "threshold": _number(config.threshold),
-        "excluded_cycles": list(analysis.excluded_cycles),
-        "min_n": config.min_n,
-        "freeze_after": config.freeze_after,
-        "baseline": None if config.baseline is None else config.baseline.source or "baseline",
-        "channels": {name: channel_to_json(c) for name, c in analysis.channels.items()},
-        "spatial": None if analysis.spatial is None else spatial_to_json(analysis.spatial),
-        "hints": list(analysis.hints),
-    }
-
-
-def _numbered_in_order(cycles: Any) -> bool:
-    """True when ``cycles`` is exactly 1, 2, ..., n."""
-    import numpy as np
-
-    numbers = np.asarray(cycles)
-    return bool(numbers.size == 0 or np.array_equal(numbers, np.arange(1, numbers.size + 1)))

@@ -17,7 +17,7 @@ branch. Its rules:
   in words) when they first appear; an alarm is new unless it flags a cycle an alarm of the
   same rule and channel already flagged (a run growing by a point is one alarm). The live
   analysis judges against frozen (phase II) limits, so a written alarm never goes away, and a
-  replay of the file (:func:`~station.analysis.live.replay_live_alarms`) gives exactly the
+  replay of the file (:func:`~station.analysis.monitor.replay_live_alarms`) gives exactly the
   alarm events written. The retrospective chart (limits from every reading) is not
   journalled: it is a function of the readings, and the reports compute it and mark each of
   its alarms live or retrospective.
@@ -59,16 +59,17 @@ from station import verdicts
 from station.errors import StationError
 from station.run.alarms import AlarmJournal
 from station.run.intake import InstrumentIntake
+from station.run.notices import LiveNotices
 from station.run.readings import cycle_times
 from station.run.services import StepServices
 from station.run.setup import SessionSetup, resume_setup, unroll
 from station.run.state import (
     Action,
+    CycleLog,
     CycleOutcome,
     CycleRecord,
     Listener,
     OperatorMessage,
-    RunnerNotice,
     RunnerState,
     RunnerStatus,
     StepView,
@@ -132,7 +133,7 @@ class Journal(Protocol):
     def close(self) -> None: ...
 
 
-class Runner(InstrumentIntake, AlarmJournal, StepServices):
+class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
     """The state machine of one session; build it with :meth:`start` or :meth:`resume`.
 
     ``gauges`` is a started gauge set (:func:`~station.run.setup.open_gauges`); the engine
@@ -195,6 +196,13 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices):
         self.config = analysis_config(self.header)
         self.kind = verdicts.kind_of(setup.procedure.analysis)
         self._live: verdicts.LiveVerdict = self.kind.live(self.config, setup.channels, self.header)
+        # The live analysis's changes, the last one computed (version, analysis, result,
+        # problem) and the thread that sends it to the listener (station.run.notices).
+        self._live_version = 0
+        self._analysed: tuple[int, Any, Any, StationError | None] | None = None
+        self._analysis_wanted = threading.Event()
+        self._analysis_stop = False
+        self._analysis_thread: threading.Thread | None = None
         self._views: tuple[StepView, ...] = ()
         self._views_position = -1
         self._last_event: dict[str, Any] | None = None
@@ -383,10 +391,12 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices):
             index = accepted[-1]
             record = self._cycles[index]
             self.append("reject", cycle=record.cycle, reason=reason, by=by, notify=False)
+            # A new list: the states already taken keep the cycles as they were.
+            self._cycles = list(self._cycles)
             self._cycles[index] = replace(record, rejected=reason)
             self._rebuild_live()
             self.say("info", f"Cycle {record.cycle} rejected: {reason}.")
-            self._notify(self._last_event, analysis=True)
+            self._notify(self._last_event)  # the analysis without it follows
             return record.cycle
 
     def note(self, text: str, by: str = "operator") -> None:
@@ -491,23 +501,6 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices):
         """The sha256 of the file's last line (print it: it anchors the file)."""
         return str(self._writer.last_hash)
 
-    def analysis(self) -> Any:
-        """The live analysis of the session so far (the analysis kind's; for repeatability equal
-        to the batch analysis of the session file). StationError before there is anything."""
-        with self.lock:
-            snapshot = self._live.snapshot()
-            if hasattr(snapshot, "excluded_cycles"):
-                rejected = tuple(r.cycle for r in self._cycles if r.rejected is not None)
-                snapshot = replace(snapshot, excluded_cycles=rejected)
-            return snapshot
-
-    def analysis_or_none(self) -> Any:
-        """:meth:`analysis`, or ``None`` while there is nothing to analyse."""
-        try:
-            return self.analysis()
-        except StationError:
-            return None
-
     def state(self) -> RunnerState:
         """An immutable snapshot of where the session is."""
         with self.lock:
@@ -533,7 +526,7 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices):
                 progress=progress,
                 placement=item.placement if item is not None else None,
                 placements=item.placements if item is not None else None,
-                cycles=tuple(self._cycles),
+                cycles=CycleLog(self._cycles, self._accepted_count),
                 instruments=self._instrument_states(),
                 messages=tuple(self._messages),
                 last_hash=self.last_hash,
@@ -566,6 +559,7 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices):
             self._accepted_by_step[key] = self._accepted_by_step.get(key, 0) + 1
         self._accepted_count = len(accepted)
         self._live = self._live.rebuilt([(r.values, r.cycle, r.times) for r in accepted], session)
+        self._live_changed()
 
     def zero_recorded(self, event: Mapping[str, Any]) -> None:
         """A ``zero`` event is on disk: the zero in force changed, and with it what the
@@ -583,6 +577,7 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices):
         if config.zero_uncertainty != self.config.zero_uncertainty:
             self.config = config
             self._live = self.kind.live(self.config, self.setup.channels, self.header)
+            self._live_changed()
 
     def _item_or_none(self) -> PlanItem | None:
         return self._plan[self._position] if self._position < len(self._plan) else None
@@ -616,26 +611,12 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices):
         """Close the file and let go of the gauges (the subscription is cancelled, so a gauge
         set resumed on again and again never keeps dead engines) and end the intake thread."""
         self._writer.close()
+        self._stop_analysis_thread()
         if self._subscription is not None:
             self._subscription.cancel()
             self._subscription = None
         if self._intake is not None:
             self._intake.put(None)
-
-    def _notify(self, event: Mapping[str, Any] | None, *, analysis: bool = False) -> None:
-        if self._listener is None:
-            return
-        live = self.analysis_or_none() if analysis else None
-        result = self._live.result() if analysis else None
-        self._tell(RunnerNotice(event, self.state(), analysis=live, result=result))
-
-    def _tell(self, notice: RunnerNotice) -> None:
-        if self._listener is None:
-            return
-        try:
-            self._listener(notice)
-        except Exception as error:  # a display's bug must not undo a recorded event
-            self._messages.append(OperatorMessage("error", f"the display failed: {error!r}"))
 
 
 __all__ = ["CAPTURE_BY", "Gauges", "Journal", "Runner"]

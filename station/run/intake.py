@@ -15,6 +15,7 @@ import threading
 import time
 from typing import TYPE_CHECKING, Any
 
+from station.analysis.diagnostics import import_scipy
 from station.errors import StationError
 from station.run.readings import DEVICE_DRIVEN_TRIGGERS
 from station.run.state import (
@@ -40,6 +41,10 @@ class InstrumentIntake:
             target=self._take_in, name="runner intake", daemon=True
         )
         self._intake_thread.start()
+        # scipy loads where the analysis first uses it: here on a thread of its own, early,
+        # rather than on the intake under the lock when the live limits freeze mid-session.
+        threading.Thread(target=import_scipy, name="runner warm-up", daemon=True).start()
+        self._start_analysis_thread()
         try:
             for reader in getattr(self.gauges, "readers", ()):
                 self._port_states[reader.url] = reader.state

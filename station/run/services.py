@@ -197,17 +197,18 @@ class StepServices:
         self._accepted_by_step[item.key] = self._accepted_by_step.get(item.key, 0) + 1
         self._accepted_count += 1
         # Acknowledged: the listener hears of the reading as soon as it is on disk, with the
-        # state that includes it (the last-reading line); the live figures and alarms follow.
+        # state that includes it (the last-reading line); the alarms follow, and the live
+        # analysis comes from the analysis thread (station.run.notices).
         self._notify(self._last_event)
         self._record_alarms(self._live.add_cycle(record.values, number, record.times), number)
-        self._notify(None, analysis=True)
+        self._live_changed()
         return CycleOutcome(recorded=True, message=record.line(), cycle=record)
 
     def stroke_recorded(self, outcome: StrokeOutcome) -> None:
         """A whole stroke is on disk: the live analysis takes it and the listener hears."""
         with self.lock:
             self._live.add_stroke(outcome)
-            self._notify(None, analysis=True)
+            self._live_changed()
 
     def refuse(self, message: str) -> CycleOutcome:
         """A set not recorded, with the operator's sentence."""

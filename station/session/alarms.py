@@ -7,7 +7,7 @@
   procedure's ``causes``), ``text`` (required for "other"), ``action`` (the corrective action,
   optional), ``by`` (optional). :func:`ack_fields` checks them before the engine writes them.
 * :func:`live_events` turns a session's readings and rejections (in journal order) into the
-  input of :func:`station.analysis.live.replay_live_alarms`: a replay gives the recorded live
+  input of :func:`station.analysis.monitor.replay_live_alarms`: a replay gives the recorded live
   alarms (same channel, rule, points, cycles and text, in the same order).
 """
 
@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from station.analysis.live import ReadingSet, Rejection
+from station.analysis.monitor import ReadingSet, Rejection
 from station.analysis.rules import rule_name
 from station.errors import StationError
 from station.plain import plain

@@ -54,7 +54,10 @@ def analysis_config(
     set and threshold (single readings, subgroup 1); ``zeroes`` (the session's ``zero``
     events) give each channel's zero uncertainty."""
     resolution = header.get("resolution")
-    minimum, freeze = header.get("cycles_min"), header.get("freeze_after")
+    # Streamed strokes are judged one straightness per stroke: their verdict is final from the
+    # strokes the procedure's stroke step asks for, not from its count of cycles.
+    minimum = header.get("strokes_min", header.get("cycles_min"))
+    freeze = header.get("freeze_after")
     return AnalysisConfig(
         limits=header_limits(header),
         resolution=float(resolution) if isinstance(resolution, int | float) else None,

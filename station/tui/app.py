@@ -133,6 +133,7 @@ class StationApp(App[int]):
         self._last_redraw = 0.0
         self._redraw_pending = False
         self._oldest_pending = 0.0
+        self._analysis_due = False
         self.redraw_hooks: list[Callable[[float], None]] = []
         """Called after each redraw with the oldest pending event's stamp (for the benchmark)."""
         self.reading_hooks: list[Callable[[], None]] = []
@@ -453,26 +454,59 @@ class StationApp(App[int]):
         sink = self.sample_sink
         if sink is not None and event_type == "samples":
             sink(notice.event)
-        self.post_message(RunnerChanged(event_type=event_type, posted_at=time.monotonic()))
+        reading = event_type == "reading"
+        self.post_message(
+            RunnerChanged(
+                event_type=event_type,
+                posted_at=time.monotonic(),
+                reading=reading,
+                # A reading's figures and charts come with the live analysis the engine sends
+                # next: its own notice changes only the last-reading line.
+                redraw=not reading,
+                analysis=notice.analysis is not None or notice.result is not None,
+            )
+        )
 
     def on_runner_changed(self, message: RunnerChanged) -> None:
         """A reading on disk is painted at once as one cheap line (the counters and last
-        values); the whole screen is redrawn now if the last redraw is old enough, else once
-        when it is (at most ~10 a second, whatever the rate)."""
-        if message.event_type == "reading":
+        values); anything else (the live analysis that follows it, a step, an alarm) redraws
+        the whole screen now if the last redraw is old enough, else once when it is (at most
+        ~10 a second, whatever the rate)."""
+        if message.reading:
             self._paint_last_reading()
+            self._analysis_due = True
+        if not message.redraw:
+            return
         if not self._oldest_pending or message.posted_at < self._oldest_pending:
             self._oldest_pending = message.posted_at
+        if message.analysis:
+            # The engine sends its live analysis at most ~10 times a second already: drawn at
+            # once, the charts are never a redraw budget behind the figures.
+            self._analysis_due = False
+            self.redraw_live()
+            return
         if self._redraw_pending:
             return
         wait = self._last_redraw + REDRAW_INTERVAL - time.monotonic()
+        if self._analysis_due:
+            # The analysis a reading brings redraws the screen soon: what changed with it (an
+            # alarm, a message) is drawn then, unless it takes longer than a redraw budget.
+            wait = REDRAW_INTERVAL
         if wait <= 0:
             self.redraw_live()
         else:
             self._redraw_pending = True
-            self.set_timer(wait, self.redraw_live)
+            self.set_timer(wait, self._redraw_when_due)
+
+    def _redraw_when_due(self) -> None:
+        """The coalesced redraw, unless one since drew everything it waited for."""
+        self._redraw_pending = False
+        if self._oldest_pending:
+            self.redraw_live()
 
     def _paint_last_reading(self) -> None:
+        if not self.screen_stack:
+            return  # the app is closing: no screen to paint
         with self._state_lock:
             state = self._latest_state
         screen = self.screen
@@ -485,13 +519,12 @@ class StationApp(App[int]):
 
     def redraw_live(self) -> None:
         """Hand the newest runner state to the screen showing it; switch screens on step kind."""
-        self._redraw_pending = False
         self._last_redraw = time.monotonic()
         oldest, self._oldest_pending = self._oldest_pending, 0.0
         with self._state_lock:
             state = self._latest_state
-        if state is None or self.runner is None:
-            return
+        if state is None or self.runner is None or not self.screen_stack:
+            return  # nothing to show, or the app is closing (a redraw timer outlived it)
         if not self._show_runner_screen(state):
             screen = self.screen
             show = getattr(screen, "show_state", None)

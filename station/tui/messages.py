@@ -24,13 +24,23 @@ class RunnerChanged(Message):
 
     event_type: str = ""
     posted_at: float = 0.0
+    reading: bool = False
+    """A reading set is on disk: paint the last-reading line at once."""
+    redraw: bool = True
+    """More than a reading changed (the live analysis, a step, an alarm, a message): redraw
+    the whole screen (coalesced, at most ~10 a second)."""
+    analysis: bool = False
+    """The notice carries the engine's live analysis (sent at most ~10 a second)."""
 
     def can_replace(self, message: Message) -> bool:
         """Coalesce with an adjacent pending ``RunnerChanged``: only the newest state matters."""
         if isinstance(message, RunnerChanged):
             # Textual drops this (older) message for the pending newer one: hand it the older
-            # stamp so the latency of the whole burst stays honest.
+            # stamp so the latency of the whole burst stays honest, and what it asked for.
             message.posted_at = min(self.posted_at, message.posted_at)
+            message.reading = message.reading or self.reading
+            message.redraw = message.redraw or self.redraw
+            message.analysis = message.analysis or self.analysis
             return True
         return False
 

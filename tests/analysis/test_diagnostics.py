@@ -19,9 +19,10 @@ from station.analysis.diagnostics import (
     percentile_capability,
     trend,
 )
+from station.analysis.document import to_json
 from station.analysis.report import format_report
 from station.analysis.rules import rule_name
-from station.analysis.summary import AnalysisConfig, analyze, to_json
+from station.analysis.summary import AnalysisConfig, analyze
 from station.analysis.verdict import cpk_text, judge_verdict, verdict_line
 
 LIMITS = SpecLimits(-0.001, 0.001)

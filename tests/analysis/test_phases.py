@@ -7,18 +7,12 @@ import numpy as np
 import pytest
 
 from station.analysis.capability import SpecLimits
-from station.analysis.live import (
-    ControlBaseline,
-    FrozenLimits,
-    LiveAnalysis,
-    LiveMonitor,
-    ReadingSet,
-    Rejection,
-    replay_live_alarms,
-)
+from station.analysis.document import to_json
+from station.analysis.live import ControlBaseline, FrozenLimits, LiveAnalysis
+from station.analysis.monitor import LiveMonitor, ReadingSet, Rejection, replay_live_alarms
 from station.analysis.phases import baseline_from_json, baseline_to_json
 from station.analysis.report import format_report
-from station.analysis.summary import AnalysisConfig, analyze, analyze_channel, to_json
+from station.analysis.summary import AnalysisConfig, analyze, analyze_channel
 from station.errors import StationError
 
 CONFIG = AnalysisConfig(default_limits=SpecLimits(-0.002, 0.002), unit="in", resolution=0.00001)

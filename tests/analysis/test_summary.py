@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from station.analysis.capability import SpecLimits
-from station.analysis.summary import AnalysisConfig, analyze, to_json
+from station.analysis.document import to_json
+from station.analysis.summary import AnalysisConfig, analyze
 from station.errors import StationError
 
 REPORT_LIMITS = SpecLimits(lsl=-0.001, usl=0.001, nominal=0.0)

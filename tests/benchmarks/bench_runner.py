@@ -63,7 +63,7 @@ def through_runner(rate: float, seconds: float, folder: Path) -> dict[str, float
         operator="bench",
         ports=(PortSetup(url, "mitutoyo", {"1": "x", "2": "y", "3": "z"}),),
         trigger="push",
-        cycles=10_000_000,
+        cycles=1_000_000,  # the most a header takes
     )
     gauges = open_gauges(setup, backoff=(0.05, 0.2))
     assert gauges.wait_connected(5.0)

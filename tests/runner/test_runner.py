@@ -11,8 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from station.analysis.live import replay_live_alarms
-from station.analysis.summary import analyze, to_json
+from station.analysis.document import to_json
+from station.analysis.monitor import replay_live_alarms
+from station.analysis.summary import analyze
 from station.errors import StationError
 from station.instruments.simulator import Faults
 from station.run import Runner, RunnerNotice

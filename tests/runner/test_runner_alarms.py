@@ -8,7 +8,7 @@ import re
 
 import pytest
 
-from station.analysis.live import replay_live_alarms
+from station.analysis.monitor import replay_live_alarms
 from station.analysis.report import format_report
 from station.errors import StationError
 from station.run import Runner

@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from station.analysis.live import LiveMonitor, replay_live_alarms
+from station.analysis.monitor import LiveMonitor, replay_live_alarms
 from station.errors import StationError
 from station.session.alarms import (
     ack_fields,

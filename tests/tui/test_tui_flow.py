@@ -18,7 +18,7 @@ from pathlib import Path
 
 from textual.widgets import Footer, Input, Static
 
-from station.analysis.summary import to_json
+from station.analysis.document import to_json
 from station.session.model import load_session
 from station.tui.app import StationApp, StationConfig
 from station.tui.screens.alarms import AckDialog, AlarmsScreen

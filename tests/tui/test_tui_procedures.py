@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 from textual.widgets import Input, Static
 
-from station.analysis.summary import to_json
+from station.analysis.document import to_json
 from station.tui.app import REDRAW_INTERVAL, DemoPort, StationApp, StationConfig
 from station.tui.instruments import DemoLab
 from station.tui.screens.checklist import ChecklistScreen

@@ -31,6 +31,13 @@ STILL_SECONDS = 2.0
 """How long the scale must rest at an end for a stroke to close there."""
 
 
+def stroke_counts(setup: SessionSetup, step: Step) -> tuple[int, int]:
+    """(target, minimum) whole strokes of a stroke step: the set-up's count, when it gives one,
+    is the target and bounds the minimum."""
+    target = int(setup.strokes or step.count_target or 1)
+    return target, min(int(step.count_min or target), target)
+
+
 class StrokeStep(StepHandler):
     """Done by the operator's confirm once its minimum of whole strokes is streamed."""
 
@@ -38,13 +45,18 @@ class StrokeStep(StepHandler):
     schema = StepSchema(channels=True, counts=True, direction=True, implies_analysis="linearity")
 
     def header_fields(self, setup: SessionSetup, step: Step) -> Mapping[str, Any]:
-        # One deadband rule, recorded: the live split and any later re-split use this value.
-        return {"deadband": stroke_deadband(setup.resolved_resolution)}
+        return {
+            # One deadband rule, recorded: the live split and any later re-split use this value.
+            "deadband": stroke_deadband(setup.resolved_resolution),
+            # A linearity verdict is final from the strokes the procedure's step asks for at
+            # least (a trial run the set-up shortens stays provisional, as a short run of
+            # cycles does).
+            "strokes_min": int(step.count_min or step.count_target or 1),
+        }
 
     def counts(self, run: Runner, item: PlanItem) -> tuple[int, int]:
         """(target, minimum) strokes (the set-up's count when it gives one)."""
-        target = int(run.setup.strokes or item.step.count_target or 1)
-        return target, min(int(item.step.count_min or target), target)
+        return stroke_counts(run.setup, item.step)
 
     def whole_strokes(self, run: Runner, item: PlanItem) -> int:
         """Whole strokes recorded in the step."""

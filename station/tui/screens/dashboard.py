@@ -246,18 +246,24 @@ class DashboardScreen(Screen[None]):
         if not self.live or not self.is_mounted:
             return
         view = DashboardView.from_live(state, self.app.live_analysis(), self.app.session_header)
-        self._draw_text(view)
+        # Repainted in place: laying the whole screen out again costs more than the paint
+        # itself, and the sizes stay (a prompt that wraps differently is laid out by the
+        # redraw that follows with the live analysis).
+        self._draw_text(view, layout=False)
 
-    def _draw_text(self, view: DashboardView) -> None:
-        """The title with the counters, the prompt and the statistics (the last values)."""
+    def _draw_text(self, view: DashboardView, *, layout: bool = True) -> None:
+        """The title with the counters, the prompt and the statistics (the last values);
+        ``layout=False``: repaint them without laying the screen out again."""
         self.view = view
         if view.channels and self.selected not in view.channels:
             self.selected = view.channels[0]
         title = shown(view.title, style="bold", limit=200)
         title.append(f"   {view.progress}", style="bold cyan")
-        self.query_one("#dash-title", Static).update(title)
+        # The title is one line high: its size never changes.
+        self.query_one("#dash-title", Static).update(title, layout=False)
         self.query_one("#dash-prompt", Static).update(
-            shown(view.prompt, style="bold green" if view.ready_to_finish else "")
+            shown(view.prompt, style="bold green" if view.ready_to_finish else ""),
+            layout=layout,
         )
         self.query_one(StatsPanel).show(
             StatsRows(
@@ -268,7 +274,8 @@ class DashboardScreen(Screen[None]):
                 unit=view.unit,
                 selected=self.selected,
                 flags=view.flags,
-            )
+            ),
+            layout=layout,
         )
 
     def draw(self, view: DashboardView) -> None:

@@ -125,11 +125,13 @@ class StatsPanel(Static):
         super().__init__(id=id, classes=classes)
         self._rows: StatsRows | None = None
 
-    def show(self, rows: StatsRows) -> None:
-        """Redraw with new rows (UI thread only)."""
+    def show(self, rows: StatsRows, *, layout: bool = True) -> None:
+        """Redraw with new rows (UI thread only); ``layout=False`` repaints in place without
+        laying the screen out again (the same channels: the same rows)."""
         if rows != self._rows:
+            same_rows = self._rows is not None and self._rows.channels == rows.channels
             self._rows = rows
-            self.update(stats_table(rows))
+            self.update(stats_table(rows), layout=layout or not same_rows)
 
 
 def channel_rows(
