@@ -282,6 +282,13 @@ def test_a_wheel_carries_the_builtin_procedures(tmp_path: Path) -> None:
     shipped = {Path(n).name for n in names if n.startswith("station/builtin_procedures/")}
     expected = {p.name for p in (REPO / "procedures").glob("*.toml")}
     assert "repeatability.toml" in shipped and expected <= shipped
+    # Every package of the source tree is in the wheel (a package split out of a module must
+    # also be named in pyproject.toml's list, or an installed station cannot import it).
+    packages = {
+        str(init.parent.relative_to(REPO)) for init in (REPO / "station").rglob("__init__.py")
+    }
+    missing = {package for package in packages if f"{package}/__init__.py" not in names}
+    assert not missing, f"not in the wheel: {sorted(missing)}"
 
     # Installed from the wheel alone (no checkout beside it), the procedures are still found.
     target = tmp_path / "installed"
