@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 
 from station.analysis.capability import Capability, SpecLimits
 from station.analysis.descriptive import Histogram
-from station.analysis.diagnostics import p_phrase
+from station.analysis.diagnostics import PERCENTILE_MIN_N, p_phrase
 from station.analysis.rules import number_list, rule_name
 from station.analysis.spatial import Spatial
 from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis
@@ -193,6 +193,17 @@ def format_diagnostics(channel: ChannelAnalysis, decimals: int, width: int = 80)
             if normal.ties:
                 lines += _wrap(f"  Note: {normal.ties}", width)
     percentile = channel.percentile
+    if (
+        percentile is None
+        and normal is not None
+        and normal.rejected
+        and (normal.n < PERCENTILE_MIN_N)
+    ):
+        lines += _wrap(
+            f"  The data are not normal: Cpk from sigma may mislead, and {normal.n} readings are "
+            f"too few for percentile indices (at least {PERCENTILE_MIN_N}).",
+            width,
+        )
     if percentile is not None:
         lines += _wrap(
             f"  The data are not normal: Cpk from sigma may mislead. {percentile.method}, "

@@ -160,6 +160,22 @@ def test_normal_data_keep_the_normal_method_and_the_percentile_index_is_close_to
     assert percentile.ppk == pytest.approx(channel.capability.cpk, rel=0.1)
 
 
+def test_a_handful_of_non_normal_readings_get_no_percentile_index():
+    """Five placements (relative accuracy's few readings): a Johnson fit to them invents its
+    tails (a Ppk of 114,618 once). No percentile index below the report's 25 readings; the
+    report says why, and the verdict keeps the normal indices."""
+    values = np.array([0.0, 0.00001, 0.0, -0.00001, 0.0009])
+    assert normality(values).rejected
+    assert percentile_capability(values, LIMITS) is None
+    channel = analyze({"x": values}, AnalysisConfig(default_limits=LIMITS)).channels["x"]
+    assert channel.percentile is None and channel.capability_method == "normal"
+    text = " ".join(
+        format_report(analyze({"x": values}, AnalysisConfig(default_limits=LIMITS))).split()
+    )
+    assert "5 readings are too few for percentile indices (at least 25)" in text
+    assert "Ppk (percentile)" not in text
+
+
 def test_large_samples_use_anderson_darling():
     values = np.random.default_rng(2).normal(0, 1, 6000)
     result = normality(values)

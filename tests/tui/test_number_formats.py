@@ -78,5 +78,9 @@ async def test_the_dashboard_writes_one_format_and_its_columns_stand_still(
             header = next(line for line in text.splitlines() if "reading" in line)
             headers.append(_column_starts(header))
             assert "zero " in text  # the zero line, beside the table
+            # Whole, never cut at 80 columns ("zero x +0.…" before): on its own line when the
+            # port's status leaves no room beside it.
+            (zero,) = [line for line in text.splitlines() if "zero x " in line]
+            assert "…" not in zero and zero.rstrip().endswith("readings)"), zero
             assert tui.odd_figures(text) == [], text
         assert headers[0] == headers[1] == headers[2], headers

@@ -359,6 +359,10 @@ class Simulator:
         """Send ``sets`` reading sets now (one frame per channel), as a DATA press would."""
         with self._lock:
             for _ in range(sets):
+                if self._stopping.is_set():
+                    # Nobody drains a line being closed: each frame would wait out its write
+                    # deadline, and a backlog of sets would hold up the stop for seconds.
+                    break
                 silent = self._chance(self.faults.silence_rate)
                 for device in self.channel_map:
                     if not silent:

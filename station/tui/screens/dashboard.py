@@ -301,7 +301,11 @@ class DashboardScreen(Screen[None]):
             instruments.show(view.ports)
             if view.zero:
                 line = status_text(view.ports)
-                line.append(f"  ·  {view.zero}")
+                # The zero in force is never cut: beside the ports when it fits, else on a
+                # line of its own (a long port name, a narrow terminal).
+                room = self.app.size.width - 2  # the line's padding
+                fits = len(line.plain) + len(view.zero) + 5 <= room
+                line.append(f"  ·  {view.zero}" if fits else f"\n{view.zero}")
                 instruments.update(line)
         else:
             instruments.update(Text("recorded session (read-only)", style="dim"))
