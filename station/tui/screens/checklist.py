@@ -146,19 +146,28 @@ class ChecklistScreen(Screen[None]):
             action += " (Demo: the robot and the gauges are simulated; just press Enter.)"
         self.query_one("#step-action", Static).update(Text(action, style="bold cyan"))
         if todo is not None and todo.kind == "input":
+            rows = []
             for field in todo.fields:
                 unit = f" ({field.unit})" if field.unit else ""
-                row = Horizontal(
-                    Label(shown(f"{field.label}{unit}"), classes="field-label"),
-                    Input(
-                        compact=True,
-                        id=f"input-{field.name}",
-                        type="number" if field.type == "number" else "text",
-                    ),
-                    classes="field-row",
+                rows.append(
+                    Horizontal(
+                        Label(shown(f"{field.label}{unit}"), classes="field-label"),
+                        Input(
+                            compact=True,
+                            id=f"input-{field.name}",
+                            type="number" if field.type == "number" else "text",
+                        ),
+                        classes="field-row",
+                    )
                 )
-                inputs.mount(row)
-            self.call_after_refresh(self._focus_first_input)
+            self.call_later(self._mount_fields, inputs, rows)
+
+    async def _mount_fields(self, inputs: Vertical, rows: list[Horizontal]) -> None:
+        # The first field takes the focus once it is mounted: focusing after a refresh alone
+        # could run before the mount, leave the focus on the step list, and the operator's
+        # first typed figures would go nowhere.
+        await inputs.mount_all(rows)
+        self._focus_first_input()
 
     def _demo_pendant(self, view: StepView) -> str | None:
         """What the demo's simulated pendant shows at this placement (None off the demo)."""
