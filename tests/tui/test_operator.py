@@ -534,7 +534,9 @@ async def test_relative_accuracy_at_80x24_pendant_fields_instruction_and_capture
                     pilot, lambda before=before: app.runner.state().current.index != before
                 )
             await tui.wait_until(pilot, lambda: len(app.screen.query("#step-inputs Input")) == 3)
-            await pilot.pause(0.2)
+            # The first field takes the focus (once mounted: awaited, not slept for).
+            await tui.wait_until(pilot, lambda: getattr(app.screen.focused, "id", "") == "input-x")
+            await pilot.pause(0.1)
             panel = app.screen.query_one("#step-panel")
             shown = fixture.pendant(app.runner.state().current.placement)
             # Typed by keyboard: each field in view as it is typed into.

@@ -146,28 +146,19 @@ class ChecklistScreen(Screen[None]):
             action += " (Demo: the robot and the gauges are simulated; just press Enter.)"
         self.query_one("#step-action", Static).update(Text(action, style="bold cyan"))
         if todo is not None and todo.kind == "input":
-            rows = []
             for field in todo.fields:
                 unit = f" ({field.unit})" if field.unit else ""
-                rows.append(
-                    Horizontal(
-                        Label(shown(f"{field.label}{unit}"), classes="field-label"),
-                        Input(
-                            compact=True,
-                            id=f"input-{field.name}",
-                            type="number" if field.type == "number" else "text",
-                        ),
-                        classes="field-row",
-                    )
+                row = Horizontal(
+                    Label(shown(f"{field.label}{unit}"), classes="field-label"),
+                    Input(
+                        compact=True,
+                        id=f"input-{field.name}",
+                        type="number" if field.type == "number" else "text",
+                    ),
+                    classes="field-row",
                 )
-            self.call_later(self._mount_fields, inputs, rows)
-
-    async def _mount_fields(self, inputs: Vertical, rows: list[Horizontal]) -> None:
-        # The first field takes the focus once it is mounted: focusing after a refresh alone
-        # could run before the mount, leave the focus on the step list, and the operator's
-        # first typed figures would go nowhere.
-        await inputs.mount_all(rows)
-        self._focus_first_input()
+                inputs.mount(row)
+            self.call_after_refresh(self._focus_first_input)
 
     def _demo_pendant(self, view: StepView) -> str | None:
         """What the demo's simulated pendant shows at this placement (None off the demo)."""
@@ -182,12 +173,19 @@ class ChecklistScreen(Screen[None]):
         """Mark the focused field's row (its label in reverse video)."""
         mark_focused_row(self, event.widget)
 
-    def _focus_first_input(self) -> None:
-        for widget in self.query("#step-inputs Input"):
-            widget.focus()
-            # All the fields in view at once (at 80×24 they sit below the step's text).
-            self.query_one("#step-inputs").scroll_visible(animate=False)
+    def _focus_first_input(self, tries: int = 20) -> None:
+        fields = list(self.query("#step-inputs Input"))
+        if not fields:
+            # Not mounted yet (a busy terminal): look again after the next refresh, so the
+            # focus never stays on the step list and the first typed figures go nowhere.
+            if tries:
+                self.call_after_refresh(self._focus_first_input, tries - 1)
             return
+        if self.focused in fields:
+            return  # the operator is already in a field
+        fields[0].focus()
+        # All the fields in view at once (at 80×24 they sit below the step's text).
+        self.query_one("#step-inputs").scroll_visible(animate=False)
 
     # -- actions --------------------------------------------------------------------------
 
