@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from station.errors import StationError
-from station.session.model import load_session
+from station.session.model import Session, load_session
 from station.session.replay import Status
 
 SESSIONS_ENV = "STATION_SESSIONS"
@@ -61,6 +61,32 @@ class SessionSummary:
     last_hash: str = ""
     torn: bool = False
     error: str | None = None
+    counted: str = "cycles"
+    """What the session counts: ``cycles``, ``placements`` (a repeated block: fixture
+    placements, joints, positions) or ``points`` (streamed along a bar, toward strokes)."""
+    done: int = 0
+    """How many of them the file holds (a placement counts once any of it is in)."""
+    target: int | None = None
+    """How many cycles, placements or strokes the set-up asked for (None: not said)."""
+
+    @property
+    def progress(self) -> str:
+        """``12 of 30 cycles``, ``2 of 3 placements`` (or ``12 cycles``); a stroke session
+        ``1420 points, 3 strokes asked``."""
+        if self.counted == "points":
+            return f"{self.done} points, {self.target} strokes asked"
+        if self.target:
+            return f"{self.done} of {self.target} {self.counted}"
+        return f"{self.done} {self.counted}"
+
+    @property
+    def progress_brief(self) -> str:
+        """:attr:`progress` for a narrow column: ``30/30 cycles``, ``2/3 placed``,
+        ``1420 points``."""
+        if self.counted == "points":
+            return f"{self.done} points"
+        word = "placed" if self.counted == "placements" else self.counted
+        return f"{self.done}/{self.target} {word}" if self.target else f"{self.done} {word}"
 
     @property
     def resumable(self) -> bool:
@@ -86,7 +112,34 @@ def summarise(path: Path) -> SessionSummary:
         operator=session.operator,
         last_hash=session.last_hash,
         torn=session.torn is not None,
+        **_progress(session),
     )
+
+
+def _progress(session: Session) -> dict[str, object]:
+    """What ``session`` counts, how many are in and how many were asked for: points toward
+    strokes for a stroke step (a linearity session streams points, not cycles), placements for a
+    repeated block, else accepted cycles."""
+    header = session.header
+    strokes, placements = header.get("strokes_target"), header.get("placements_target")
+    if isinstance(strokes, int):
+        # Which stretches of the stream are whole strokes is the analysis's to say (a listing
+        # loads no numpy): the points streamed are what the file plainly holds.
+        points = sum(len(batch.values) for batch in session.samples)
+        return {"counted": "points", "done": points, "target": strokes}
+    if isinstance(placements, int):
+        accepted = set(session.accepted_cycles)
+        reached = {
+            cycle.placement
+            for number, cycle in session.cycles.items()
+            if number in accepted and cycle.placement is not None
+        }
+        return {"counted": "placements", "done": len(reached), "target": placements}
+    return {
+        "counted": "cycles",
+        "done": len(session.accepted_cycles),
+        "target": session.cycles_target,
+    }
 
 
 def list_sessions(folder: str | os.PathLike[str]) -> list[SessionSummary]:

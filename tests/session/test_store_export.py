@@ -10,7 +10,7 @@ from pathlib import Path
 
 from station.session.export import CSV_COLUMNS, export_csv
 from station.session.model import load_session
-from station.session.store import find_unfinished, list_sessions, sessions_folder
+from station.session.store import find_unfinished, list_sessions, sessions_folder, summarise
 
 from .conftest import reading_fields, write_session
 
@@ -92,3 +92,22 @@ def test_listing_sessions_loads_no_numpy(tmp_path: Path) -> None:
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == ["2", "1", "False"]
+
+
+def test_a_summary_counts_what_its_procedure_counts() -> None:
+    """The home screen's resume line and the review list said "0 of 30 cycles" of a linearity
+    session that had streamed its 3 strokes (it records points, not cycles), and "3 of 5
+    cycles" of 3 fixture placements asked for."""
+    saved = Path(__file__).resolve().parents[1] / "tui" / "snapshots" / "sessions"
+    summaries = {s.procedure: s for s in map(summarise, sorted(saved.glob("*.jsonl")))}
+    assert {name: s.progress for name, s in summaries.items()} == {
+        "repeatability": "30 of 30 cycles",
+        "linearity": "1420 points, 3 strokes asked",
+        "relative_accuracy": "3 of 3 placements",
+    }
+    # The review list's column is narrow.
+    assert {name: s.progress_brief for name, s in summaries.items()} == {
+        "repeatability": "30/30 cycles",
+        "linearity": "1420 points",
+        "relative_accuracy": "3/3 placed",
+    }

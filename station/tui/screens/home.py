@@ -169,17 +169,11 @@ class HomeScreen(Screen[None]):
 
 
 def _resume_label(summary: Any) -> str:
-    """``Resume R1 repeatability, interrupted after 12 of 30 cycles (2026-11-23 17:40)``."""
+    """``Resume: R1 repeatability (interrupted, 12 of 30 cycles, 2026-11-23 17:40)``: what the
+    session counts (cycles, placements or strokes)."""
     created = str(getattr(summary, "created", ""))[:16].replace("T", " ")
     status = getattr(summary, "status", "unfinished")
-    cycles = getattr(summary, "cycles", None)
-    target = getattr(summary, "cycles_target", None)
-    done = (
-        f", {cycles} of {target} cycles"
-        if target
-        else (f", {cycles} cycles" if cycles is not None else "")
-    )
     return (
         f"Resume: {getattr(summary, 'robot', '?')} {getattr(summary, 'procedure', '')}"
-        f" ({status}{done}, {created})"
+        f" ({status}, {summary.progress}, {created})"
     )

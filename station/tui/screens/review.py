@@ -74,7 +74,7 @@ class ReviewScreen(Screen[None]):
         table.add_column("created (UTC)", key="created")
         table.add_column("verdict / state", key="verdict")
         table.add_column("procedure", key="procedure")
-        table.add_column("cycles", key="cycles")
+        table.add_column("done", key="cycles")
         self._fill()
         table.focus()
         finished = [s.path for s in self._all if not s.error and s.status == "finished"]
@@ -96,9 +96,7 @@ class ReviewScreen(Screen[None]):
                     shown(summary.path.name, limit=120), "", "unreadable", "", "", key=str(index)
                 )
                 continue
-            cycles = f"{summary.cycles}"
-            if summary.cycles_target:
-                cycles += f"/{summary.cycles_target}"
+            cycles = summary.progress_brief
             if summary.rejected:
                 cycles += f" ({summary.rejected} rej.)"
             table.add_row(

@@ -329,7 +329,19 @@ def recorded_summary(header: dict[str, Any]) -> Text:
         f"robot {plain(header.get('robot'), limit=80)}, operator "
         f"{plain(header.get('operator'), limit=80)}, procedure "
         f"{procedure.get('id')} {procedure.get('version')}, unit {header.get('unit')}, "
-        f"resolution {header.get('resolution')}, {header.get('cycles_target')} cycles.\n"
+        f"resolution {header.get('resolution')}, {_asked_for(header)}.\n"
         "Check the instrument line below (the port may have changed), then press F2."
     )
     return text
+
+
+def _asked_for(header: Mapping[str, Any]) -> str:
+    """``30 cycles``, ``3 placements`` or ``25 strokes``: what the set-up asked for."""
+    for key, word in (
+        ("strokes_target", "strokes"),
+        ("placements_target", "placements"),
+        ("cycles_target", "cycles"),
+    ):
+        if isinstance(header.get(key), int):
+            return f"{header[key]} {word}"
+    return "no count recorded"
