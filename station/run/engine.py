@@ -567,17 +567,25 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
         stays equal to the batch analysis of the file). Lock held."""
         for channel, zeroed in dict(event.get("channels") or {}).items():
             self.recorded_zero[str(channel)] = dict(zeroed)
-        self._zero_config()
-        self._rebuild_live()
+        if not self._zero_config():
+            return
+        # A live analysis on the new config, fed the cycles taken so far in order (rebuilt as
+        # after a reject it would adopt the new, empty one's monitor and drop them all). Their
+        # alarms are on disk already: what the feeding raises again is not recorded twice.
+        for record in self._cycles:
+            if record.rejected is None:
+                self._live.add_cycle(record.values, record.cycle, record.times)
+        self._live_changed()
 
-    def _zero_config(self) -> None:
-        """The analysis config with the recorded zeros' uncertainties; a new live analysis on
-        it (the caller rebuilds it from the cycles)."""
+    def _zero_config(self) -> bool:
+        """The analysis config with the recorded zeros' uncertainties, and a new (empty) live
+        analysis on it when that changed (the caller feeds it the cycles); True then."""
         config = analysis_config(self.header, [{"channels": self.recorded_zero}])
-        if config.zero_uncertainty != self.config.zero_uncertainty:
-            self.config = config
-            self._live = self.kind.live(self.config, self.setup.channels, self.header)
-            self._live_changed()
+        if config.zero_uncertainty == self.config.zero_uncertainty:
+            return False
+        self.config = config
+        self._live = self.kind.live(self.config, self.setup.channels, self.header)
+        return True
 
     def _item_or_none(self) -> PlanItem | None:
         return self._plan[self._position] if self._position < len(self._plan) else None

@@ -12,11 +12,13 @@ from pathlib import Path
 import pytest
 from helpers import STATION
 
+from station.analysis.document import to_json
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import GaugeSpec, Simulator, TwoFixtureModel
 from station.procedures import discover_procedures
 from station.run import PortSetup, Runner, SessionSetup
 from station.session.model import load_session
+from station.verdicts import analyze_session_file
 
 from .playing import play_capture
 
@@ -99,6 +101,15 @@ def test_the_runner_walks_relative_accuracy_against_the_two_fixture_simulator(
                 runner.submit_input({a: str(v) for a, v in zip("xyz", pendant, strict=True)})
             else:
                 assert runner.capture(5.0).recorded
+        # A zero at every placement changes the zero in force: the live analysis still holds
+        # every capture (a zero once rebuilt it empty from the second placement on) and judges
+        # them as the batch analysis of the file does.
+        live = runner.analysis()
+        assert live.channels["x"].descriptive.n == PLACEMENTS
+        batch = to_json(analyze_session_file(runner.path).analysis)["channels"]
+        for channel, shown in to_json(live)["channels"].items():
+            for part in ("n", "mean", "sd", "range", "capability", "out_of_spec", "alarms"):
+                assert shown[part] == batch[channel][part], (channel, part)
         runner.finish()
     finally:
         simulator.stop()
