@@ -11,6 +11,7 @@ import time
 
 from station.commands._args import positive_number
 from station.errors import StationError
+from station.instruments.triggers import TRIGGERS
 from station.text import parse_channel_map
 
 DESCRIPTION = """\
@@ -75,7 +76,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--trigger",
-        choices=("poll", "push", "stable", "arrival"),
+        choices=TRIGGERS,
         help="poll (default for a polled protocol), push (default otherwise), stable or arrival",
     )
     parser.add_argument("--count", metavar="N", help="stop after N readings")

@@ -9,6 +9,7 @@ inline SVG, no script and a Content-Security-Policy that allows nothing from out
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -76,8 +77,18 @@ def render_content(
 
 def render_report(path: str | Path, fmt: str = "txt") -> str:
     """The filed report of the session file at ``path`` in ``fmt`` (txt, md or html): what
-    ``station report`` writes and the TUI's export saves."""
-    if fmt not in FORMATS:
-        raise StationError(f"unknown report format {fmt!r}; choose one of {', '.join(FORMATS)}.")
+    ``station report`` writes."""
+    return render_reports(path, (fmt,))[fmt]
+
+
+def render_reports(path: str | Path, formats: Sequence[str]) -> dict[str, str]:
+    """The filed report of the session file at ``path`` in each of ``formats``, from one
+    reading and analysis of the file (the TUI's export files text and HTML at once)."""
+    for fmt in formats:
+        if fmt not in FORMATS:
+            raise StationError(
+                f"unknown report format {fmt!r}; choose one of {', '.join(FORMATS)}."
+            )
     analysed = analyse_session(path)
-    return render_content(build_content(analysed), fmt, analysed)
+    content = build_content(analysed)
+    return {fmt: render_content(content, fmt, analysed) for fmt in formats}

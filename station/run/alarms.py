@@ -99,6 +99,5 @@ class AlarmJournal:
             raised_at=raised_at,
             live=True,
         )
-        self._alarm_count += 1
         self._alarm_list = (*self._alarm_list, recorded_alarm(event))
         self.say("warning", f"{channel}: {rule_name(alarm.rule)}: {alarm.text}")

@@ -186,7 +186,6 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
         self._failure: str | None = None
         self._warned_position = -1
         self._messages: deque[OperatorMessage] = deque(maxlen=_MESSAGES_KEPT)
-        self._alarm_count = 0
         self._alarm_flagged: dict[tuple[str, str], set[int]] = {}
         self._alarm_list: tuple[RecordedAlarm, ...] = ()
         self._port_states: dict[str, str] = {}
@@ -290,7 +289,6 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
                     for channel, zeroed in dict(event.get("channels") or {}).items():
                         self.recorded_zero[str(channel)] = dict(zeroed)
                 elif kind == "alarm":
-                    self._alarm_count += 1
                     key = (str(event.get("channel")), str(event.get("rule")))
                     self._alarm_flagged.setdefault(key, set()).update(event.get("cycles") or ())
                 item = items.get((str(event.get("step")), event.get("placement")))
@@ -530,11 +528,12 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
                 instruments=self._instrument_states(),
                 messages=tuple(self._messages),
                 last_hash=self.last_hash,
-                alarms=self._alarm_count,
+                alarms=len(self._alarm_list),
                 alarm_list=self._alarm_list,
                 failure=self._failure or "",
                 next_cycle=self._next_cycle,
-                zero={channel: dict(zeroed) for channel, zeroed in self.recorded_zero.items()},
+                # Entries are replaced whole, never changed in place: a shallow copy will do.
+                zero=dict(self.recorded_zero),
             )
 
     def prompt(self) -> str:

@@ -66,6 +66,7 @@ from __future__ import annotations
 import argparse
 
 from station.commands.capture.command import run
+from station.instruments.triggers import TRIGGERS
 from station.procedures import UNITS
 
 
@@ -105,7 +106,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--trigger",
-        choices=("poll", "push", "stable", "arrival"),
+        choices=TRIGGERS,
         help="poll: ask the gauges (paced by --every or Enter); push: they send (DATA button, "
         "foot switch); stable: take the set once it settles; arrival: read continuously and "
         "take a set each time the robot leaves and comes back to rest (default: the "

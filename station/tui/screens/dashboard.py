@@ -30,7 +30,7 @@ from station.tui.text import shown, shown_line
 from station.tui.widgets.alarm_log import AlarmLog, alarm_lines, recorded_alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.histogram import HistogramView, histogram_data
-from station.tui.widgets.instrument_status import InstrumentStatus, status_text
+from station.tui.widgets.instrument_status import InstrumentStatus
 from station.tui.widgets.stats_panel import StatsPanel, StatsRows
 
 if TYPE_CHECKING:
@@ -77,6 +77,12 @@ class DashboardView:
         )
         accepted = [record for record in state.cycles if record.rejected is None]
         last_cycle = state.last_cycle
+        # A rejected cycle is shown as rejected: no value, and no out-of-spec flag beside it.
+        last = (
+            dict(last_cycle.values)
+            if last_cycle is not None and last_cycle.rejected is None
+            else {}
+        )
         current = state.current
         counted = state.progress
         rejected = len(state.cycles) - len(accepted)
@@ -122,16 +128,14 @@ class DashboardView:
             prompt=prompt,
             channels=channels,
             analyses=dict(analysis.channels) if analysis is not None else {},
-            last=dict(last_cycle.values)
-            if last_cycle is not None and last_cycle.rejected is None
-            else {},
+            last=last,
             cycle_numbers=tuple(record.cycle for record in accepted),
             ports=tuple(state.instruments),
             message=message,
             resolution=header.get("resolution"),
             unit=str(header.get("unit", "")),
             ready_to_finish=ready,
-            flags=out_of_spec_flags(last_cycle.values if last_cycle is not None else {}, header),
+            flags=out_of_spec_flags(last, header),
             alarms=tuple(state.alarm_list),
             no_alarms=no_alarms_words(header, len(accepted)),
             zero=zero_line(state.zero, header.get("resolution")),
@@ -298,15 +302,7 @@ class DashboardScreen(Screen[None]):
             log.show(alarm_lines(view.analyses, view.cycle_numbers))
         instruments = self.query_one(InstrumentStatus)
         if self.live:
-            instruments.show(view.ports)
-            if view.zero:
-                line = status_text(view.ports)
-                # The zero in force is never cut: beside the ports when it fits, else on a
-                # line of its own (a long port name, a narrow terminal).
-                room = self.app.size.width - 2  # the line's padding
-                fits = len(line.plain) + len(view.zero) + 5 <= room
-                line.append(f"  ·  {view.zero}" if fits else f"\n{view.zero}")
-                instruments.update(line)
+            instruments.show(view.ports, view.zero, width=self.app.size.width - 2)
         else:
             instruments.update(Text("recorded session (read-only)", style="dim"))
         # The message line says the newest news: a capture's outcome (said by this screen) or

@@ -20,7 +20,7 @@ from textual.widgets import DataTable, Footer, Static
 
 from station.errors import StationError
 from station.session.store import list_sessions, status_words
-from station.text import overall_verdict, verdict_word
+from station.text import overall_judgement
 from station.tui.remedies import explained
 from station.tui.screens.dialogs import HelpScreen, TextPrompt
 from station.tui.screens.summary import SummaryScreen, SummaryView
@@ -135,7 +135,9 @@ class ReviewScreen(Screen[None]):
             try:
                 view = SummaryView.from_file(path)
                 channels = getattr(view.analysis, "channels", {}) or {}
-                word = overall_verdict([verdict_word(c.capability) for c in channels.values()])
+                # The summary's own judgement, its first word in the narrow column (a session
+                # below the minimum count is PROVISIONAL here too, never CAPABLE).
+                word = overall_judgement(channels.values()).partition(":")[0]
             except (StationError, OSError, ValueError, AttributeError):
                 word = "—"
             self.app.call_from_thread(self._show_verdict, path, word)

@@ -382,11 +382,11 @@ class SummaryScreen(Screen[None]):
         """The filed report (the same as ``station report FILE``: robot, operator, procedure,
         gauges, zero, limits, every reading, notes, alarms, verdicts, anchor, sign-off) beside
         the session file, as text and as a self-contained HTML page with its charts."""
-        from station.record.render import render_report  # deferred: it loads numpy
+        from station.record.render import render_reports  # deferred: it loads numpy
 
         try:
-            text = render_report(self.view.path, "txt")
-            page = render_report(self.view.path, "html")
+            reports = render_reports(self.view.path, ("txt", "html"))
+            text, page = reports["txt"], reports["html"]
         except StationError as error:
             self.notify(shown_line(explained(error), limit=None), severity="error", markup=False)
             return

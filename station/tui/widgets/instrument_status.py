@@ -43,6 +43,12 @@ class InstrumentStatus(Static):
     InstrumentStatus { height: auto; }
     """
 
-    def show(self, ports: Sequence[Any]) -> None:
-        """Redraw from a runner state's ``instruments`` (UI thread only)."""
-        self.update(status_text(ports))
+    def show(self, ports: Sequence[Any], zero: str = "", width: int = 80) -> None:
+        """Redraw from a runner state's ``instruments`` and the zero in force (UI thread only):
+        the zero is never cut, beside the ports when the line has room (``width`` columns),
+        else on a line of its own (a long port name, a narrow terminal)."""
+        line = status_text(ports)
+        if zero:
+            fits = len(line.plain) + len(zero) + 5 <= width
+            line.append(f"  ·  {zero}" if fits else f"\n{zero}")
+        self.update(line)
