@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
+from decimal import Decimal
 from statistics import NormalDist
 
 import numpy as np
@@ -215,8 +216,10 @@ def capability(
         mean, sigma = mean_and_sd(array)
         if sigma == 0:
             reasons.append(
-                f"sigma is 0: every reading is the same ({mean:g}), so the indices are "
-                "undefined; check that the gauge is reading and its resolution is fine enough"
+                # Positional, as every other figure on the screens ("-4e-05" read as a code).
+                f"sigma is 0: every reading is the same ({format(Decimal(repr(float(mean))), 'f')})"
+                ", so the indices are undefined; check that the gauge is reading and its "
+                "resolution is fine enough"
             )
         within = sigma_within if sigma_within is not None else estimate_sigma_within(array, size)
         if within is None and sigma:

@@ -89,6 +89,9 @@ def test_zero_sigma_gives_a_message_and_no_indices():
     assert (result.cp, result.cpu, result.cpl, result.cpk, result.cpk_lower) == (None,) * 5
     assert (result.cp_within, result.cpk_within, result.capable) == (None, None, None)
     assert result.message.startswith("sigma is 0: every reading is the same (0.0002)")
+    # Positional like every other figure, never "-4e-05".
+    still = capability([-0.00004] * 30, LIMITS)
+    assert "every reading is the same (-0.00004)" in still.message
 
 
 @pytest.mark.parametrize("values", [[], [0.0004]])
