@@ -92,7 +92,7 @@ class DemoFixture:
         motion = getattr(self.simulator, "motion", None)
         if motion is None:
             return
-        now = time.monotonic() - self.simulator.motion_t0
+        now = self.simulator.clock() - self.simulator.motion_t0
         start, _ = motion.rest_window(int(now // motion.period))
         if now - start > REST_START_SLACK * motion.period:
             start, _ = motion.rest_window(int(now // motion.period) + 1)
@@ -101,7 +101,11 @@ class DemoFixture:
 
     def stop(self) -> None:
         """Close the pseudo-terminal and stop the simulator's thread."""
-        _RUNNING.pop(self.url, None)
+        # Only this fixture's own entry: the kernel gives a closed /dev/pts/N to the next
+        # pseudo-terminal opened, and a second stop of a stale fixture would otherwise untrack
+        # the new set-up that now serves that path.
+        if _RUNNING.get(self.url) is self:
+            del _RUNNING[self.url]
         self.simulator.stop()
 
 
@@ -112,7 +116,12 @@ robot where the steps say (:meth:`DemoFixture.follow`)."""
 
 def track(fixture: DemoFixture) -> DemoFixture:
     """Follow ``fixture`` (a simulated set-up started in this process) in the sessions that
-    use its URL, until it stops."""
+    use its URL, until it stops: from now on the procedure's steps play its robot."""
+    # ``station simulate``'s still robot moves to its next rest after a pause in the polls
+    # (``return_gap``), standing in for an operator nobody plays. Followed, it must not move
+    # as well: a slow screen between the frames check and the zero (a loaded machine) would
+    # move it off the plate, and the zero would be taken on the block.
+    fixture.simulator.return_gap = None
     _RUNNING[fixture.url] = fixture
     return fixture
 
