@@ -35,6 +35,22 @@ def test_any_single_flipped_byte_fails_verify_and_names_its_line(position: int, 
     assert f"line {result.first_bad_line}:" in result.message
 
 
+def test_a_newline_written_into_the_last_line_names_the_last_line() -> None:
+    """Found by the property above (about one run in 80): a byte of the last line's hash flipped
+    to a newline split it in two, and verify named the torn piece after it (line 15), not the
+    damaged line 14 before it. Every byte of the last line, turned into a newline."""
+    last = DATA.count(b"\n")
+    start = DATA.rstrip(b"\n").rfind(b"\n") + 1
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "s.jsonl"
+        for position in range(start, len(DATA) - 1):
+            damaged = bytearray(DATA)
+            damaged[position] = ord("\n")
+            path.write_bytes(bytes(damaged))
+            result = verify_session(path)
+            assert (result.ok, result.first_bad_line) == (False, last), (position, result.message)
+
+
 def _load_or_station_error(data: bytes) -> None:
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "s.jsonl"
