@@ -1,6 +1,26 @@
-"""Settings for the whole suite."""
+"""Settings and isolation for the whole suite.
 
+Every test starts from the same process state, whatever ran before it and on whichever worker:
+
+* its own home, config, data, state and cache folders (``HOME`` and ``XDG_*``), so the signing
+  key, the remembered set-up, the baselines, the default sessions folder and the gauge register
+  (``STATION_GAUGES``) are the test's alone, for it and every process it starts;
+* none of the developer's ``STATION_*`` settings, nor ``NO_COLOR``;
+* the registries of step and analysis kinds as the station's own modules fill them (a kind a
+  test registers is gone after it);
+* no simulated set-up left followed from an earlier test (``station.tui.instruments``).
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
 import signal
+from collections.abc import Iterator
+
+import pytest
+
+pytest_plugins = ["pytester"]
 
 # A shell that starts the suite as a background job (`pytest &`, some CI runners) sets SIGINT
 # to "ignored", and every subprocess a test starts would inherit that: the tests that press
@@ -11,16 +31,81 @@ if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
-import pytest  # noqa: E402
+def _import_every_station_module() -> None:
+    """Import all of ``station`` once, so that every built-in kind has registered itself before
+    the registries are copied (a module first imported by a test would otherwise register its
+    kinds after the copy, and lose them at the next reset)."""
+    import station
+
+    for module in pkgutil.walk_packages(station.__path__, "station."):
+        if not module.name.endswith("__main__"):
+            importlib.import_module(module.name)
+
+
+_import_every_station_module()
+
+from station.procedures import kinds as _procedure_kinds  # noqa: E402
+from station.run import steps as _steps  # noqa: E402
+from station.tui import instruments as _demo_instruments  # noqa: E402
+from station.verdicts import registry as _verdicts  # noqa: E402
+
+_REGISTRIES: tuple[dict, ...] = (
+    _verdicts._KINDS,
+    _steps._HANDLERS,
+    _procedure_kinds._STEP_SCHEMAS,
+    _procedure_kinds._ANALYSES,
+)
+"""The process-wide registries a test may add to, as the station's modules filled them."""
+_BUILT_IN = tuple(dict(registry) for registry in _REGISTRIES)
+
+PRIVATE_ENVIRONMENT = ("STATION_SESSIONS", "STATION_PROCEDURES", "STATION_THEME", "NO_COLOR")
+"""The developer's settings that would change what a test sees; unset for every test."""
+
+
+def _reset_registries() -> None:
+    # In place: the station's functions hold these very dicts.
+    for registry, built_in in zip(_REGISTRIES, _BUILT_IN, strict=True):
+        registry.clear()
+        registry.update(built_in)
+
+
+def _stop_followed_fixtures() -> None:
+    for fixture in list(_demo_instruments._RUNNING.values()):
+        fixture.stop()
+    _demo_instruments._RUNNING.clear()
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _matplotlib_folder(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """One matplotlib folder (its font cache) per worker, outside the real home; built once,
+    not in every test's fresh home."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("MPLCONFIGDIR", str(tmp_path_factory.mktemp("matplotlib")))
+        yield
 
 
 @pytest.fixture(autouse=True)
-def _station_config_home(tmp_path_factory: pytest.TempPathFactory, monkeypatch) -> None:
-    """Every test (and every process it starts) keeps the station's signing key and its
-    remembered set-up in a temporary config folder of its own, never in the real home (and a
-    set-up remembered by one test never pre-fills another's form), and its gauge register in a
-    temporary file."""
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path_factory.mktemp("config-home")))
-    # A gauge register of the test's own: a finished gauge check writes to it, and a new
-    # session reads it; never the real one in the data folder.
-    monkeypatch.setenv("STATION_GAUGES", str(tmp_path_factory.mktemp("gauges") / "gauges.json"))
+def _private_process_state(
+    tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch
+) -> Iterator[None]:
+    """The test's own folders and settings and the station's registries as built (see the
+    module); set for the test and every process it starts. The folders are beside the test's
+    ``tmp_path``, not in it, so a test that lists its ``tmp_path`` sees only its own files."""
+    home = tmp_path_factory.mktemp("home")
+    monkeypatch.setenv("HOME", str(home))
+    for variable, folder in (
+        ("XDG_CONFIG_HOME", ".config"),
+        ("XDG_DATA_HOME", ".local/share"),
+        ("XDG_STATE_HOME", ".local/state"),
+        ("XDG_CACHE_HOME", ".cache"),
+    ):
+        monkeypatch.setenv(variable, str(home / folder))
+    # Named, so a test can read the register a finished gauge check wrote.
+    monkeypatch.setenv("STATION_GAUGES", str(home / "gauges.json"))
+    for variable in PRIVATE_ENVIRONMENT:
+        monkeypatch.delenv(variable, raising=False)
+    _reset_registries()
+    _stop_followed_fixtures()
+    yield
+    _stop_followed_fixtures()
+    _reset_registries()

@@ -80,7 +80,7 @@ def _spread(inputs: KindInputs) -> Judgement:
 
 
 def register() -> None:
-    """Register both kinds (idempotent)."""
+    """Register both kinds (idempotent); the suite's registries lose them after each test."""
     register_step(SoakStep())
     register_kind(
         AnalysisKind(
@@ -93,6 +93,3 @@ def register() -> None:
             count=lambda ranges: f"{len(ranges)} channels",
         )
     )
-
-
-register()

@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 import soak_kinds
 
 from station.session.model import load_session
@@ -17,10 +18,19 @@ from station.tui.screens.summary import SummaryScreen
 
 HERE = Path(__file__).resolve().parent
 
+
+@pytest.fixture(autouse=True)
+def soak_kinds_registered() -> None:
+    """The soak step and the spread analysis, for this test only (the suite resets the
+    registries after each test)."""
+    soak_kinds.register()
+
+
 RUN_WITH_KINDS = """
 import sys
 sys.path.insert(0, sys.argv[1])
-import soak_kinds  # registers the soak step and the spread analysis
+import soak_kinds
+soak_kinds.register()  # the soak step and the spread analysis
 from station.cli import main
 sys.exit(main(sys.argv[2:]))
 """
