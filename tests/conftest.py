@@ -6,6 +6,7 @@ Every test starts from the same process state, whatever ran before it and on whi
   key, the remembered set-up, the baselines, the default sessions folder and the gauge register
   (``STATION_GAUGES``) are the test's alone, for it and every process it starts;
 * none of the developer's ``STATION_*`` settings, nor ``NO_COLOR``;
+* temporary folders on tmpfs (``/dev/shm``), where durability is not what a test can see;
 * the registries of step and analysis kinds as the station's own modules fill them (a kind a
   test registers is gone after it);
 * no simulated set-up left followed from an earlier test (``station.tui.instruments``).
@@ -14,13 +15,22 @@ Every test starts from the same process state, whatever ran before it and on whi
 from __future__ import annotations
 
 import importlib
+import os
 import pkgutil
 import signal
+import tempfile
 from collections.abc import Iterator
 
 import pytest
+from hypothesis import settings
+
+from tests.properties import THOROUGH
 
 pytest_plugins = ["pytester"]
+
+# The long property run: each property test's own count (tests/properties.py), and 1000
+# examples where a test names none.
+settings.register_profile(THOROUGH, max_examples=1000)
 
 # A shell that starts the suite as a background job (`pytest &`, some CI runners) sets SIGINT
 # to "ignored", and every subprocess a test starts would inherit that: the tests that press
@@ -29,6 +39,16 @@ pytest_plugins = ["pytester"]
 # exec; an ignored one is not).
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+# Temporary folders (every tmp_path, and those of the processes the tests start) in memory, on
+# tmpfs: a session's fsync there costs nothing, and no test can tell a disk from it (a process
+# killed with SIGKILL leaves its written data in either; the disk-limit tests mount their own
+# small tmpfs). A TMPDIR the developer set is kept.
+SHARED_MEMORY = "/dev/shm"
+if "TMPDIR" not in os.environ and os.access(SHARED_MEMORY, os.W_OK | os.X_OK):
+    os.environ["TMPDIR"] = SHARED_MEMORY
+    tempfile.tempdir = None  # read TMPDIR again
 
 
 def _import_every_station_module() -> None:

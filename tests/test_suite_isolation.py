@@ -65,7 +65,16 @@ def test_plain_pytest_imports_the_suites_own_modules() -> None:
     importers = ["tests/tui/test_followed_fixture.py", "tests/runner/test_paced_capture.py"]
     pytest_script = Path(sys.executable).with_name("pytest")
     done = subprocess.run(
-        [str(pytest_script), "--collect-only", "-q", "-p", "no:cacheprovider", *importers],
+        [
+            str(pytest_script),
+            "--collect-only",
+            "-q",
+            "-n",
+            "0",
+            "-p",
+            "no:cacheprovider",
+            *importers,
+        ],
         cwd=REPO,
         capture_output=True,
         text=True,

@@ -12,6 +12,8 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
+import pytest
+
 from station.errors import StationError
 from station.session.model import load_session
 from station.session.verify import verify_session
@@ -78,6 +80,7 @@ def check_killed(run: Killed) -> str:
     return session.status
 
 
+@pytest.mark.slow  # kill -9 at many points
 def test_kill9_at_random_moments(simulators, tmp_path):
     urls = [simulators(seed).url for seed in range(WORKERS)]
 
