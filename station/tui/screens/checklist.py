@@ -30,6 +30,12 @@ if TYPE_CHECKING:
     from station.run import Action, RunnerState, StepView
     from station.tui.app import StationApp
 
+ZERO_WAIT = 5.0
+"""Seconds a zero waits for the gauges (a port that is down, a gauge that moves)."""
+ARRIVAL_ZERO_WAIT = 30.0
+"""Under the arrival trigger, seconds a zero waits for the robot on its loop to come to rest
+at the fixture: a round trip or several."""
+
 ENTER_DOES = {
     "confirm": "Press Enter when this is done.",
     "zero": "Keep the robot still, then press Enter to zero the indicators.",
@@ -212,21 +218,15 @@ class ChecklistScreen(Screen[None]):
             }
             self._do(lambda: runner.submit_input(values))
         elif kind == "zero":
-            fixture = self.app.demo_fixture
-            if fixture is None:
-                self.query_one("#step-message", Static).update(Text("Zeroing ...", style="yellow"))
-                self._do(runner.zero)
-                return
-            # The demo's robot never stops: zero when it has just come to rest at the fixture.
-            self.query_one("#step-message", Static).update(
-                Text("Zeroing once the simulated robot is at rest at the fixture ...", "yellow")
-            )
-
-            def zero_at_rest() -> None:
-                fixture.wait_at_rest()
-                runner.zero()
-
-            self._do(zero_at_rest)
+            message = "Zeroing ..."
+            timeout = ZERO_WAIT
+            if runner.setup.trigger == "arrival":
+                # The robot runs its loop: the gauges wait for it to come to rest at the
+                # fixture (never at the plungers' stop), so give it a round trip or two.
+                message = "Zeroing once the robot is at rest at the fixture ..."
+                timeout = ARRIVAL_ZERO_WAIT
+            self.query_one("#step-message", Static).update(Text(message, style="yellow"))
+            self._do(lambda: runner.zero(timeout=timeout))
         else:
             self._do(runner.confirm)
 
