@@ -36,6 +36,10 @@ ARRIVAL_ZERO_WAIT = 30.0
 """Under the arrival trigger, seconds a zero waits for the robot on its loop to come to rest
 at the fixture: a round trip or several."""
 
+ARRIVAL_ZERO_DOES = (
+    "Press Enter: the indicators are zeroed when the robot next comes to rest at the fixture "
+    "(seen coming back from away; never at the plungers' stop)."
+)
 ENTER_DOES = {
     "confirm": "Press Enter when this is done.",
     "zero": "Keep the robot still, then press Enter to zero the indicators.",
@@ -146,6 +150,9 @@ class ChecklistScreen(Screen[None]):
             text.append(shown_line(pendant), style="bold reverse")
         self.query_one("#step-text", Static).update(text)
         action = ENTER_DOES.get(asks, "Press Enter to continue.")
+        runner = self.app.runner
+        if asks == "zero" and runner is not None and runner.setup.trigger == "arrival":
+            action = ARRIVAL_ZERO_DOES
         if self.app.config.demo is not None and asks == "input":
             action += " (Demo: copy the simulated pendant's X, Y, Z shown above.)"
         elif self.app.config.demo is not None:
