@@ -6,7 +6,6 @@ reader); nothing here parses a frame or writes a file.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -20,9 +19,6 @@ BAR_CHANNEL_MAP = {"1": "h", "2": "v", "3": "s"}
 BAR_PUSH_RATE = 200.0
 """Sets a second the simulated bar's indicators and scale send (a linear-scale counter's rate)."""
 TEST_CAPTURES = 5
-REST_START_SLACK = 0.05
-"""A zero may begin this part of a period after the simulated robot came to rest (its dwell
-is 0.35 of the period; the zero needs its settle time of stillness within it)."""
 DEMO_GAUGE_NOISE = 0.3
 """The demo indicators' own reading noise, in resolutions (σ): a robot at rest looks at rest."""
 
@@ -82,22 +78,6 @@ class DemoFixture:
             return
         if rest != simulator.rest:
             simulator.move_to_rest(rest)
-
-    def wait_at_rest(self) -> None:
-        """Block until the simulated robot has just come to rest at the fixture, as a
-        technician stops a real robot there before zeroing (a zero taken while it is away
-        would zero the indicators at their free travel, and every later cycle would be taken
-        away from the fixture); at once when the simulated robot does not move. At most one
-        period; call it from a worker thread."""
-        motion = getattr(self.simulator, "motion", None)
-        if motion is None:
-            return
-        now = self.simulator.clock() - self.simulator.motion_t0
-        start, _ = motion.rest_window(int(now // motion.period))
-        if now - start > REST_START_SLACK * motion.period:
-            start, _ = motion.rest_window(int(now // motion.period) + 1)
-        if start > now:
-            time.sleep(start - now)
 
     def stop(self) -> None:
         """Close the pseudo-terminal and stop the simulator's thread."""

@@ -40,12 +40,13 @@ def kill_once(index: int, url: str, root: Path) -> Killed:
     rng = random.Random(f"kill9/{index}")
     delay = rng.uniform(0.0, 1.0)
     # One run in six is killed counting from the start (during start-up and the header);
-    # the others counting from the moment the session file was announced (mid-capture).
+    # the others counting from the zero (mid-capture: the start-up before it takes longer on
+    # a loaded machine, and would leave too few kills among the cycles).
     from_start = index % 6 == 0
     sessions = root / f"run{index:02d}"
     capture = Capture(capture_args(url, sessions, CYCLES))
     if not from_start:
-        capture.wait_line(lambda line: line.startswith("session file: "), 20.0)
+        capture.wait_line(lambda line: line.startswith("step zero: done"), 20.0)
     time.sleep(delay)
     capture.process.send_signal(signal.SIGKILL)
     capture.finish()

@@ -111,6 +111,7 @@ def test_arrival_records_ten_cycles_one_per_round_trip_at_rest(
         "still": 2,
         "settle": 0.08,
         "timeout": 1.0,
+        "stop": "low",
     }
     cycles = [session.cycles[n] for n in sorted(session.cycles)]
     assert len(cycles) == 10
