@@ -201,9 +201,15 @@ class ArrivalDetector(Generic[Item]):
                 # that return is lost (reported), and this is a departure of its own. A stay
                 # shorter than a quarter of the settle time is a bounce of the approach (an
                 # overshoot past the band) and keeps the first arrival.
-                moving = self._unsettled_in_windows() or outside
+                # Name the channels that moved; only when none did was it the reading rate.
+                spread_out = self._spread_out()
+                moving = spread_out or self._unsettled_in_windows() or outside
                 message = unsettled_message(
-                    moving, self.config, t - arrived, left=True, sparse=self.sparse_channels()
+                    moving,
+                    self.config,
+                    t - arrived,
+                    left=True,
+                    sparse=() if spread_out else self.sparse_channels(),
                 )
                 events.append(
                     ArrivalEvent("unsettled", t, moving, t_arrived=arrived, message=message)
@@ -228,9 +234,13 @@ class ArrivalDetector(Generic[Item]):
         arrived = self.t_arrived
         if arrived is None or self.now - arrived <= self.config.timeout:
             return []
-        moving = self.moving_channels()
+        spread_out = self._spread_out()
+        moving = spread_out or self.moving_channels()
         message = unsettled_message(
-            moving, self.config, self.now - arrived, sparse=self.sparse_channels()
+            moving,
+            self.config,
+            self.now - arrived,
+            sparse=() if spread_out else self.sparse_channels(),
         )
         event: ArrivalEvent[Item] = ArrivalEvent(
             "unsettled", self.now, moving, t_arrived=arrived, message=message
@@ -242,6 +252,15 @@ class ArrivalDetector(Generic[Item]):
         for state in self._channels.values():
             state.window.clear()
         return [event]
+
+    def _spread_out(self) -> tuple[str, ...]:
+        """Channels whose kept readings spread over more than ``still`` resolutions: they
+        moved (as against channels merely seen too rarely to be judged still)."""
+        return tuple(
+            channel
+            for channel, state in self._channels.items()
+            if self.spread(channel) > self.config.still * state.resolution + 1e-12
+        )
 
     def _unsettled_in_windows(self) -> tuple[str, ...]:
         """Channels whose kept readings were not still for a settle time."""
