@@ -207,6 +207,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     motion.add_argument(
         "--hunt-every", default="1", metavar="N", help="the returns that hunt: every N-th (1)"
     )
+    motion.add_argument(
+        "--hunt-period",
+        default="0.037",
+        metavar="S",
+        help="seconds per swing of a hunting axis (0.037; a gauge read less often than twice a "
+        "swing cannot see it hunt)",
+    )
     line = parser.add_argument_group("line and faults")
     line.add_argument(
         "--push-rate",
@@ -488,7 +495,10 @@ def build_motion(args: argparse.Namespace, model, channels: list[str]):
     )
     hunt = {c: v for c, v in per_channel(args.hunt, "--hunt", channels).items() if v}
     hunt_every = positive_number(args.hunt_every, "--hunt-every", int)
-    return CycleMotion(period, free, abs(overshoot), hunt=hunt, hunt_every=hunt_every)
+    hunt_period = positive_number(args.hunt_period, "--hunt-period")
+    return CycleMotion(
+        period, free, abs(overshoot), hunt=hunt, hunt_every=hunt_every, hunt_period=hunt_period
+    )
 
 
 def show_pendant(simulator) -> None:

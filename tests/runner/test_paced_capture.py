@@ -134,7 +134,12 @@ def test_arrival_records_ten_cycles_one_per_round_trip_at_rest(
 def test_a_return_that_does_not_settle_is_reported_not_recorded(
     tmp_path: Path, procedures: Path
 ) -> None:
-    process, url = simulate("--cycle-period", str(PERIOD), "--hunt", "y=0.01", "--hunt-every", "2")
+    # A swing of 0.2 s is seen by polls every 0.0375 s (a quarter of the settle time) at any
+    # load; a swing as fast as the polls would alias into a still reading.
+    process, url = simulate(
+        "--cycle-period", str(PERIOD), "--hunt", "y=0.01", "--hunt-every", "2",
+        "--hunt-period", "0.2",
+    )  # fmt: skip
     try:
         done = capture(
             "--procedure", "paced", "--procedures", str(procedures), "--port", url,
