@@ -13,6 +13,10 @@ if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
 
 import pytest  # noqa: E402
 
+# Procedure files name the methods: the loader knows them once station.methods is imported, as
+# every front end and the engine do before loading one (tests load procedures directly).
+import station.methods  # noqa: E402, F401
+
 
 @pytest.fixture(autouse=True)
 def _station_config_home(tmp_path_factory: pytest.TempPathFactory, monkeypatch) -> None:
