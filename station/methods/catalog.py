@@ -15,6 +15,7 @@ from station.extensions import METHODS, SiteExtensions, site_extensions
 from station.methods.contract import Method
 from station.methods.gain_schedule import METHOD as GAIN_SCHEDULE
 from station.methods.gauge_check import METHOD as GAUGE_CHECK
+from station.methods.gauge_linearity import METHOD as GAUGE_LINEARITY
 from station.methods.joint_troubleshooting import METHOD as JOINT_TROUBLESHOOTING
 from station.methods.linearity import METHOD as LINEARITY
 from station.methods.relative_accuracy import METHOD as RELATIVE_ACCURACY
@@ -27,6 +28,7 @@ BUILT_IN: tuple[Method, ...] = (
     RELATIVE_ACCURACY,
     LINEARITY,
     GAUGE_CHECK,
+    GAUGE_LINEARITY,
     JOINT_TROUBLESHOOTING,
     GAIN_SCHEDULE,
 )
