@@ -1,5 +1,7 @@
-"""What several test modules share: ``station simulate`` as a real subprocess, and the small
-procedure files the procedure and capture tests write.
+"""What several test modules share: ``station`` run in this process (:func:`run_station`, the
+fast default) or as a real subprocess (:data:`STATION`, where the process boundary is what the
+test is about), ``station simulate`` as a subprocess, and the small procedure files the
+procedure and capture tests write.
 
 Imported as ``from helpers import ...``: pytest puts ``tests/`` on ``sys.path`` for the suite's
 own ``conftest.py``.
@@ -7,17 +9,86 @@ own ``conftest.py``.
 
 from __future__ import annotations
 
+import contextlib
+import io
+import os
 import signal
 import subprocess
 import sys
 import textwrap
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 
 import pytest
 
+from station.cli import main as station_main
+
 STATION = [sys.executable, "-m", "station"]
-"""The station command as this interpreter runs it."""
+"""The station command as this interpreter runs it, for a real process."""
+
+_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+"""Signals a command may take over; given back to the test runner after each in-process run."""
+
+
+def run_station(
+    *args: str | os.PathLike[str],
+    input: str | bytes | None = None,
+    env: Mapping[str, str] | None = None,
+    cwd: str | os.PathLike[str] | None = None,
+) -> subprocess.CompletedProcess[str]:
+    """``station ARGS`` run in this process by ``station.cli.main``, answered as
+    ``subprocess.run([*STATION, *ARGS], capture_output=True, text=True)`` would be: the exit
+    code and what the command wrote, as text (UTF-8, newlines as a pipe gives them).
+
+    ``input``: the command's standard input (else empty; not a terminal, without a file
+    descriptor, so a command that reads the terminal's descriptor needs a real process).
+    ``env`` replaces the environment and ``cwd`` the working folder for the call. An exception
+    the command does not handle is raised here, with its traceback, rather than turned into
+    exit 1.
+    """
+    raw_in = input.encode("utf-8") if isinstance(input, str) else (input or b"")
+    out, err = io.BytesIO(), io.BytesIO()
+    stdin = io.TextIOWrapper(io.BytesIO(raw_in), encoding="utf-8")
+    stdout = io.TextIOWrapper(out, encoding="utf-8", write_through=True)
+    stderr = io.TextIOWrapper(err, encoding="utf-8", write_through=True)
+    handlers = {number: signal.getsignal(number) for number in _SIGNALS}
+    saved = sys.stdin, sys.stdout, sys.stderr
+    sys.stdin, sys.stdout, sys.stderr = stdin, stdout, stderr
+    try:
+        with _environment(env), contextlib.chdir(cwd or os.getcwd()):
+            try:
+                code = station_main([os.fspath(arg) for arg in args])
+            except SystemExit as stop:  # argparse's usage errors and --help
+                code = stop.code if isinstance(stop.code, int) else (0 if stop.code is None else 1)
+                if isinstance(stop.code, str):
+                    print(stop.code, file=sys.stderr)
+    finally:
+        sys.stdin, sys.stdout, sys.stderr = saved
+        for number, handler in handlers.items():
+            signal.signal(number, handler)
+    return subprocess.CompletedProcess(
+        ["station", *map(os.fspath, args)], code, _as_text(out), _as_text(err)
+    )
+
+
+def _as_text(stream: io.BytesIO) -> str:
+    # As subprocess.run(text=True) reads a pipe: UTF-8, universal newlines.
+    return stream.getvalue().decode("utf-8").replace("\r\n", "\n").replace("\r", "\n")
+
+
+@contextlib.contextmanager
+def _environment(env: Mapping[str, str] | None) -> Iterator[None]:
+    if env is None:
+        yield
+        return
+    saved = dict(os.environ)
+    os.environ.clear()
+    os.environ.update(env)
+    try:
+        yield
+    finally:
+        os.environ.clear()
+        os.environ.update(saved)
 
 
 def start_simulator(

@@ -23,11 +23,12 @@ def test_domain_packages_do_not_import_the_ui():
 
 
 def test_readme_test_command_is_what_ci_runs():
+    """CI runs the README's command under coverage: the same ``-m pytest`` with no options of
+    its own, so the suite's options (pyproject's addopts) are the same in both."""
     readme = (ROOT / "README.md").read_text()
     ci = (ROOT / ".ci" / "run").read_text()
-    test_command = ".venv/bin/python -m pytest"
-    assert test_command in readme
-    assert test_command in ci
+    assert ".venv/bin/python -m pytest\n" in readme
+    assert ".venv/bin/coverage run -m pytest\n" in ci
 
 
 def _loaded_after(code: str) -> set[str]:

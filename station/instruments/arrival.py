@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from typing import Generic, Literal, TypeVar
 
 from station.errors import StationError
+from station.instruments.travel import MIN_REST_READINGS, STOP_SIDES, StopSide
 
 DEFAULT_BAND_RESOLUTIONS = 100.0
 """Without a band, a channel has left the fixture beyond 100 resolutions from its centre."""
@@ -53,7 +54,10 @@ class ArrivalConfig:
     resolutions the readings of a settle window may spread. ``settle``: seconds of stillness
     before the set is taken. ``timeout``: seconds after the arrival by which the robot must be
     still, else the return is reported and not recorded. ``centre``: each channel's rest value
-    at the fixture (default 0: the gauges were zeroed there).
+    at the fixture (default 0: the gauges were zeroed there). ``stop``: the end of its travel
+    an indicator shows with nothing touching it (``low``: a plunger pushed in reads higher);
+    ``free_travel``: the device reading there per channel, where it is known (else the gauge
+    layer learns it from the robot's motion: :mod:`station.instruments.travel`).
     """
 
     band: float | None = None
@@ -61,6 +65,8 @@ class ArrivalConfig:
     settle: float = DEFAULT_SETTLE
     timeout: float = DEFAULT_TIMEOUT
     centre: Mapping[str, float] = field(default_factory=dict)
+    stop: StopSide = "low"
+    free_travel: Mapping[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.band is not None and not self.band > 0:
@@ -71,6 +77,8 @@ class ArrivalConfig:
             )
         if not self.settle > 0:
             raise StationError(f"The arrival settle time must be over 0 s, not {self.settle}.")
+        if self.stop not in STOP_SIDES:
+            raise StationError(f"The indicators' stop must be 'low' or 'high', not {self.stop!r}.")
         if not self.timeout > self.settle:
             raise StationError(
                 f"The arrival timeout ({self.timeout:g} s) must be longer than the settle time "
@@ -193,8 +201,16 @@ class ArrivalDetector(Generic[Item]):
                 # that return is lost (reported), and this is a departure of its own. A stay
                 # shorter than a quarter of the settle time is a bounce of the approach (an
                 # overshoot past the band) and keeps the first arrival.
-                moving = self._unsettled_in_windows() or outside
-                message = unsettled_message(moving, self.config, t - arrived, left=True)
+                # Name the channels that moved; only when none did was it the reading rate.
+                spread_out = self._spread_out()
+                moving = spread_out or self._unsettled_in_windows() or outside
+                message = unsettled_message(
+                    moving,
+                    self.config,
+                    t - arrived,
+                    left=True,
+                    sparse=() if spread_out else self.sparse_channels(),
+                )
                 events.append(
                     ArrivalEvent("unsettled", t, moving, t_arrived=arrived, message=message)
                 )
@@ -203,10 +219,7 @@ class ArrivalDetector(Generic[Item]):
             return events
         state.window.append((t, value, item))
         self._trim(state, t)
-        if all(
-            self._still_since(s) is not None and t - self._still_since(s) >= self.config.settle
-            for s in self._channels.values()
-        ) and self._fresh(t):
+        if all(self._settled(s, t) for s in self._channels.values()) and self._fresh(t):
             readings = {c: s.latest[2] for c, s in self._channels.items()}
             arrived = self.t_arrived
             self.state = "waiting"
@@ -221,8 +234,14 @@ class ArrivalDetector(Generic[Item]):
         arrived = self.t_arrived
         if arrived is None or self.now - arrived <= self.config.timeout:
             return []
-        moving = self.moving_channels()
-        message = unsettled_message(moving, self.config, self.now - arrived)
+        spread_out = self._spread_out()
+        moving = spread_out or self.moving_channels()
+        message = unsettled_message(
+            moving,
+            self.config,
+            self.now - arrived,
+            sparse=() if spread_out else self.sparse_channels(),
+        )
         event: ArrivalEvent[Item] = ArrivalEvent(
             "unsettled", self.now, moving, t_arrived=arrived, message=message
         )
@@ -234,42 +253,66 @@ class ArrivalDetector(Generic[Item]):
             state.window.clear()
         return [event]
 
+    def _spread_out(self) -> tuple[str, ...]:
+        """Channels whose kept readings spread over more than ``still`` resolutions: they
+        moved (as against channels merely seen too rarely to be judged still)."""
+        return tuple(
+            channel
+            for channel, state in self._channels.items()
+            if self.spread(channel) > self.config.still * state.resolution + 1e-12
+        )
+
     def _unsettled_in_windows(self) -> tuple[str, ...]:
         """Channels whose kept readings were not still for a settle time."""
-        moving = []
-        for channel, state in self._channels.items():
-            since = self._still_since(state)
-            if (
-                since is None
-                or not state.window
-                or state.window[-1][0] - since < self.config.settle
-            ):
-                moving.append(channel)
-        return tuple(moving)
+        return tuple(
+            channel
+            for channel, state in self._channels.items()
+            if not state.window or not self._settled(state, state.window[-1][0])
+        )
 
     def moving_channels(self) -> tuple[str, ...]:
         """Channels not still for a settle time (or out of their band) at the detector's time."""
-        settle = self.config.settle
         moving = []
         for channel, state in self._channels.items():
-            since = self._still_since(state)
             latest = state.latest
             out = latest is None or abs(latest[1] - state.centre) > state.band
             if (
                 out
-                or since is None
-                or self.now - since < settle
+                or not self._settled(state, self.now)
                 or not self._fresh_channel(state, self.now)
             ):
                 moving.append(channel)
         return tuple(moving)
 
+    def sparse_channels(self) -> tuple[str, ...]:
+        """Channels whose readings since the return came more than half a settle time apart
+        on average: too rarely to see the robot settle at all."""
+        sparse = []
+        for channel, state in self._channels.items():
+            window = state.window
+            if len(window) >= 2:
+                mean_gap = (window[-1][0] - window[0][0]) / (len(window) - 1)
+                if mean_gap > self._max_gap():
+                    sparse.append(channel)
+            elif self.t_arrived is not None and self.now - self.t_arrived > self._max_gap():
+                sparse.append(channel)
+        return tuple(sparse)
+
     # -- stillness -----------------------------------------------------------------------
 
     def _max_gap(self) -> float:
         """The longest pause between two readings of a channel that still counts as watching
-        it: a port silent for a whole settle time proves nothing about stillness."""
-        return self.config.settle
+        it: half a settle time. Two readings that happen to agree across a longer pause (a
+        swing's turning point seen at a slow push rate, or under load) prove no stillness."""
+        return self.config.settle / 2
+
+    def _settled(self, state: _Channel[Item], t: float) -> bool:
+        """True when the channel has been still for a settle time up to ``t``, seen by at
+        least ``MIN_REST_READINGS`` readings of that stretch."""
+        since = self._still_since(state)
+        if since is None or t - since < self.config.settle:
+            return False
+        return sum(1 for stamp, _, _ in state.window if stamp >= since) >= MIN_REST_READINGS
 
     def _trim(self, state: _Channel[Item], t: float) -> None:
         """Keep the readings of the last settle time, and one before it (the window's start)."""
@@ -309,13 +352,27 @@ class ArrivalDetector(Generic[Item]):
 
 
 def unsettled_message(
-    moving: Sequence[str], config: ArrivalConfig, waited: float, *, left: bool = False
+    moving: Sequence[str],
+    config: ArrivalConfig,
+    waited: float,
+    *,
+    left: bool = False,
+    sparse: Sequence[str] = (),
 ) -> str:
     """The sentence for a return that did not settle: ``left`` when the robot went away again
-    before it was still, else it was not still within the timeout."""
+    before it was still, else it was not still within the timeout; ``sparse`` names channels
+    whose readings came too rarely to judge stillness at all."""
     who = ", ".join(moving) if moving else "the gauges"
     verb = "was" if len(moving) == 1 else "were"
     when = f"before it left again ({waited:.1f} s)" if left else f"after {waited:.1f} s"
+    if sparse:
+        return (
+            f"The robot came back to the fixture but {', '.join(sparse)} sent readings more "
+            f"than {config.settle / 2:g} s apart, too rarely to see it settle within "
+            f"{config.settle:g} s {when}; no set was taken for this return. Make the gauges "
+            "send faster (a push device's rate, or a shorter poll) or lengthen the arrival "
+            "settle time."
+        )
     return (
         f"The robot came back to the fixture but {who} {verb} not still within "
         f"{config.still:g} resolutions for {config.settle:g} s {when}; "

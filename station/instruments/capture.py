@@ -36,6 +36,9 @@ class CaptureResult:
     disconnected: tuple[str, ...] = ()
     """Missing channels whose port was down for the whole wait (the set is not the gauges'
     fault: the line is reconnecting)."""
+    at_stop: tuple[str, ...] = ()
+    """Channels whose reading sits at the indicator's free-travel stop: the robot is away
+    from the fixture, so the set measures the plungers, not the robot."""
 
     @property
     def port_down(self) -> bool:
@@ -69,10 +72,21 @@ class CaptureResult:
             parts.append(
                 "more than one reading from " + ", ".join(self.duplicated) + " (the first taken)"
             )
+        if self.at_stop:
+            parts.append(at_stop_sentence(self.at_stop))
         parts.extend(self.errors)
         if not parts:
             return ""
         return "; ".join(parts) + "."
+
+
+def at_stop_sentence(channels: Iterable[str]) -> str:
+    """Why a set at the indicators' free-travel stop is no cycle, naming the channels."""
+    names = ", ".join(channels)
+    return (
+        f"{names} read their free-travel stop: the robot is away from the fixture (bring it "
+        "back to the taught point)"
+    )
 
 
 class SetCaptures:
@@ -258,6 +272,7 @@ class SetCaptures:
             errors=tuple(errors),
             t_trigger=t_trigger,
             disconnected=disconnected,
+            at_stop=self.at_stop(taken),
         )
 
     def arm(self, timeout: float = 1.0) -> list[str]:

@@ -33,8 +33,10 @@ from station.instruments.reader import (
     TriggerTicket,
     call_quietly,
 )
+from station.instruments.travel import TravelWatch
 from station.instruments.triggers import TRIGGERS, Trigger
 from station.instruments.zero_gauges import SetZeroing
+from station.text import format_figure
 
 
 @dataclass(frozen=True)
@@ -147,6 +149,17 @@ class GaugeSet(SetCaptures, SetZeroing, SetFrameChecks):
             if trigger == "arrival"
             else None
         )
+        config = self.arrival_config
+        self.travel = TravelWatch(
+            self.resolution,
+            {c: config.band_of(res) for c, res in self.resolution.items()},
+            still=config.still,
+            settle=config.settle,
+            side=config.stop,
+            free_travel=config.free_travel,
+        )
+        """Where each plunger rests with nothing touching it (stated, or learned from the
+        robot's motion), so that no zero and no set is taken with the robot away."""
         self._collectors: list[dict[str, list[GaugeReading]]] = []
         self._streaming = threading.Event()
         self._stream_thread: threading.Thread | None = None
@@ -269,6 +282,7 @@ class GaugeSet(SetCaptures, SetZeroing, SetFrameChecks):
             history = self._history.get(reading.channel)
             if history is not None:
                 history.append(reading)
+                self.travel.feed(reading.channel, reading.device_value, reading.t_mono)
                 for collector in self._collectors:
                     collector[reading.channel].append(reading)
                 if self.trigger == "push" and reading.t_mono >= self._push_armed_at:
@@ -298,6 +312,7 @@ class GaugeSet(SetCaptures, SetZeroing, SetFrameChecks):
                     self.channels,
                     dict(event.readings),
                     t_trigger=event.t_arrived if event.t_arrived is not None else event.t,
+                    at_stop=self.at_stop(event.readings),
                 )
                 self._sets.append(result)
                 return result
@@ -335,11 +350,49 @@ class GaugeSet(SetCaptures, SetZeroing, SetFrameChecks):
             dict(self._pending),
             duplicated=tuple(c for c in self.channels if c in self._pending_duplicated),
             t_trigger=min(r.t_mono for r in self._pending.values()),
+            at_stop=self.at_stop(self._pending),
         )
         self._pending.clear()
         self._pending_duplicated.clear()
         self._sets.append(result)
         return result
+
+    def waiting_sentence(self) -> str:
+        """What the gauges see while no set comes, for an operator waiting on the robot: where
+        the ``arrival`` trigger thinks the robot is and each channel's latest reading (empty
+        for another trigger)."""
+        if self._detector is None:
+            return ""
+        with self._changed:
+            latest = {c: h[-1] for c, h in self._history.items() if h}
+            state = self._detector.state
+            at_stop = self.travel.at_stop({c: r.device_value for c, r in latest.items()})
+        where = {
+            "waiting": "the robot has not left the fixture since the last set (a set is taken "
+            "each time it leaves and comes back to rest)",
+            "away": "the robot is away from the fixture",
+            "returned": "the robot came back to the fixture but is not still",
+        }[state]
+        if state == "away" and at_stop and len(at_stop) == len(self.channels):
+            where = "the indicators rest at their free-travel stop: the robot is away"
+        missing = [c for c in self.channels if c not in latest]
+        shown = " ".join(
+            f"{c} {format_figure(r.value, self.resolution[c])}" for c, r in latest.items()
+        )
+        reads = f"; the gauges read {shown}" if shown else ""
+        silent = f"; no reading from {', '.join(missing)}" if missing else ""
+        return f"{where}{reads}{silent}"
+
+    def stops(self) -> dict[str, float]:
+        """Each channel's free-travel stop as a device reading, where it is known (stated by
+        the procedure, or learned from the robot's round trips)."""
+        with self._changed:
+            return self.travel.stops()
+
+    def at_stop(self, readings: Mapping[str, GaugeReading]) -> tuple[str, ...]:
+        """The channels of ``readings`` that sit at their known free-travel stop (the robot
+        is away: such a set is never a cycle)."""
+        return self.travel.at_stop({c: r.device_value for c, r in readings.items()})
 
     def set_zero_offsets(self, offsets: Mapping[str, float]) -> None:
         """Put recorded software-zero offsets back (a resumed session on fresh gauges):

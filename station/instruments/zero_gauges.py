@@ -14,9 +14,15 @@ import time
 from collections.abc import Iterable, Mapping
 
 from station.errors import StationError
+from station.instruments.capture import at_stop_sentence
 from station.instruments.reader import GaugeReader, GaugeReading, TriggerTicket
 from station.instruments.units import unit_mismatch
-from station.instruments.zeroing import DEFAULT_ZERO_STILL, ChannelZero, zero_from_readings
+from station.instruments.zeroing import (
+    DEFAULT_ZERO_STILL,
+    ChannelZero,
+    NotAtFixture,
+    zero_from_readings,
+)
 
 
 class SetZeroing:
@@ -35,6 +41,14 @@ class SetZeroing:
         still: float = DEFAULT_ZERO_STILL,
     ) -> list[ChannelZero]:
         """Zero ``channels`` (all by default): the device's command, else a software offset.
+
+        With the ``arrival`` trigger (the robot runs its loop) the zero first waits, up to
+        ``timeout``, for the robot to be at rest at the fixture: every channel resting more than
+        its band from its free-travel stop on the cube's side, the stop stated by the procedure
+        or learned from a round trip seen (:class:`~station.instruments.travel.TravelWatch`);
+        and its readings must all come from that one rest. With any trigger, readings at a known
+        stop are refused. Either refusal is a
+        :class:`~station.instruments.zeroing.NotAtFixture` (nothing zeroed).
 
         With ``readings`` > 1 every channel is read ``readings`` times over ``settle`` seconds
         (:meth:`collect`); the zero is refused (StationError naming the channel, nothing
@@ -57,9 +71,15 @@ class SetZeroing:
         if readings < 1:
             raise StationError(f"A zero needs at least 1 reading per channel, not {readings}.")
         commands = {c: self._zero_command(c) for c in wanted}
+        rests, since = None, None
+        if self.trigger == "arrival":
+            rests, since = self._wait_at_fixture(wanted, timeout)
         if readings == 1:
             return self._zero_once(wanted, commands, timeout, unit)
-        taken = self.collect(wanted, readings, settle, timeout)
+        # Under arrival the readings that showed the rest count: a robot on its loop rests
+        # only so long at the fixture.
+        taken = self.collect(wanted, readings, settle, timeout, since=since)
+        self._refuse_away(taken, wanted, rests)
         down = [
             c
             for c in wanted
@@ -89,6 +109,56 @@ class SetZeroing:
         self._apply_zeros(zeros, commands, timeout)
         return list(zeros)
 
+    def _wait_at_fixture(
+        self, channels: list[str], timeout: float
+    ) -> tuple[tuple[float | None, ...], float]:
+        """Wait up to ``timeout`` for the robot at rest at the fixture (see :meth:`zero`);
+        the rest levels it rests at, and since when. Raises NotAtFixture with what is
+        awaited."""
+        deadline = time.monotonic() + timeout
+        with self._changed:
+            while not self.travel.at_fixture(channels):
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    raise NotAtFixture(
+                        f"Could not zero yet: {self.travel.waiting_sentence(channels)}.",
+                        tuple(channels),
+                    )
+                self._changed.wait(remaining)
+            levels = tuple(self.travel.resting(c) for c in channels)
+            return levels, self.travel.rest_start(channels)
+
+    def _refuse_away(
+        self,
+        taken: Mapping[str, list[GaugeReading]],
+        channels: list[str],
+        rests: tuple[float | None, ...] | None,
+    ) -> None:
+        """Refuse a zero read at the indicators' stop, or (``rests``: the rest levels the robot
+        was waited for at) one whose readings did not all come from that rest."""
+        at_stop = self.travel.at_stop(
+            {c: values[-1].device_value for c, values in taken.items() if values}
+        )
+        if at_stop:
+            raise NotAtFixture(
+                f"Could not zero: {at_stop_sentence(at_stop)}; zero once it rests there.",
+                at_stop,
+            )
+        if rests is None:
+            return
+        with self._changed:
+            left = [
+                c
+                for c, rest in zip(channels, rests, strict=True)
+                if self.travel.resting(c) != rest or not self.travel.at_fixture([c])
+            ]
+        if left:
+            raise NotAtFixture(
+                f"Could not zero: the robot left the fixture while the zero was read "
+                f"({', '.join(left)}); the zero is taken at its next rest there.",
+                tuple(left),
+            )
+
     def _zero_command(self, channel: str) -> bytes | None:
         reader = self._reader_of[channel]
         device_channel = next(
@@ -116,6 +186,9 @@ class SetZeroing:
                     )
                 reader.send(command)
                 reader.set_zero_offset(zero.channel, 0.0)
+                with self._changed:
+                    # The device now sends readings less its zero: what was learned moves too.
+                    self.travel.shift(zero.channel, zero.mean)
             else:
                 reader.set_zero_offset(zero.channel, zero.offset)
 
@@ -143,6 +216,12 @@ class SetZeroing:
                 mismatch = unit_mismatch(result.readings, software, unit)
                 if mismatch:
                     raise StationError(f"Could not zero: {mismatch}.")
+            if result.at_stop:
+                raise NotAtFixture(
+                    f"Could not zero: {at_stop_sentence(result.at_stop)}; zero once it rests "
+                    "there.",
+                    result.at_stop,
+                )
             for channel in software:
                 value = result.readings[channel].device_value
                 zeros[channel] = ChannelZero(
@@ -158,6 +237,8 @@ class SetZeroing:
         readings: int = 10,
         settle: float = 1.0,
         timeout: float = 2.0,
+        *,
+        since: float | None = None,
     ) -> dict[str, list[GaugeReading]]:
         """Read ``channels`` until each has ``readings`` readings and ``settle`` seconds have
         passed (or ``settle`` + ``timeout`` seconds, whichever first); the readings by channel.
@@ -166,12 +247,18 @@ class SetZeroing:
         every 10 ms, no input flushed, one request in flight); a pushing port is listened to
         (a streaming device sends by itself; a DATA button must be pressed ``readings``
         times). With the ``arrival`` trigger the streaming thread's polls count too. Only
-        readings that arrive after the call count."""
+        readings that arrive after the call count, or with ``since`` (a monotonic time) those
+        received from then on (the settle window counts from then too)."""
         wanted = list(self.channels if channels is None else channels)
         collector: dict[str, list[GaugeReading]] = {c: [] for c in self.channels}
         interval = max(0.01, settle / max(readings - 1, 1))
         start = time.monotonic()
         deadline = start + settle + timeout
+        if since is not None:
+            start = min(start, since)
+            with self._changed:
+                for channel in self.channels:
+                    collector[channel] = [r for r in self._history[channel] if r.t_mono >= since]
         polled = {self._reader_of[c] for c in wanted if self._reader_of[c].protocol.polled}
         in_flight: dict[GaugeReader, TriggerTicket] = {}
         with self._changed:

@@ -149,6 +149,12 @@ class GaugesMoving(StationError):
         self.channels = channels
 
 
+class NotAtFixture(GaugesMoving):
+    """A zero refused because the robot is not (known to be) at rest at the fixture: the
+    indicators sit at their free-travel stop, or the stop is not known yet and no return was
+    seen. Nothing was zeroed; wait for the robot and zero again."""
+
+
 def moving_message(
     moving: Sequence[tuple[str, float, float]], still: float, window: float | None, unit: str
 ) -> str:
@@ -169,6 +175,7 @@ def moving_message(
 __all__ = [
     "ChannelZero",
     "GaugesMoving",
+    "NotAtFixture",
     "DEFAULT_ZERO_READINGS",
     "DEFAULT_ZERO_SETTLE",
     "DEFAULT_ZERO_STILL",

@@ -36,6 +36,13 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
     settle = 0.5                    # seconds of stillness before the set is taken (0.5)
     timeout = 10.0                  # seconds after its return by which the robot must be
                                     # still, else the return is reported, not recorded (10)
+    stop = "low"                    # the end of its travel an indicator shows with nothing
+                                    # touching it: "low" (a plunger pushed in reads higher) or
+                                    # "high"; the station learns where it is from the robot's
+                                    # round trips, and never zeroes nor takes a set there
+    free_travel = -0.375            # optional: the reading there, before any zero (one number,
+                                    # or per channel: { x = -0.375, y = -0.37 }); with it a
+                                    # robot stopped at the fixture is zeroed without a trip
 
     [limits]                        # optional; either a tolerance about a nominal for every channel
     tolerance = 0.001

@@ -119,7 +119,9 @@ def parse_procedure(data: bytes, path: Path) -> Procedure:
         raise check.fail("[cycles]", f"min {cycles_min} is more than target {cycles_target}")
 
     limits = _parse_limits(check, check.get(table, "limits", dict, "", required=False), channels)
-    arrival = _parse_arrival(check, check.get(table, "arrival", dict, "", required=False))
+    arrival = _parse_arrival(
+        check, check.get(table, "arrival", dict, "", required=False), tuple(channels)
+    )
     trigger = check.get(table, "trigger", str, "", required=False)
     if trigger is not None and trigger not in TRIGGERS:
         raise check.fail("", f"'trigger' must be one of {', '.join(TRIGGERS)}, not {trigger!r}")
@@ -174,20 +176,52 @@ def _parse_causes(check: Checker, value: Any) -> tuple[str, ...]:
     return tuple(causes)
 
 
-def _parse_arrival(check: Checker, table: Mapping[str, Any] | None) -> ArrivalConfig:
-    """The ``[arrival]`` table: band, still, settle, timeout (each optional)."""
+def _parse_arrival(
+    check: Checker, table: Mapping[str, Any] | None, channels: tuple[str, ...]
+) -> ArrivalConfig:
+    """The ``[arrival]`` table: band, still, settle, timeout, the indicators' stop and its
+    reading (each optional)."""
     if not table:
         return ArrivalConfig()
     where = "[arrival]"
-    check.only_keys(table, ("band", "still", "settle", "timeout"), where)
-    given = {key: check.number(table, key, where) for key in table}
+    check.only_keys(table, ("band", "still", "settle", "timeout", "stop", "free_travel"), where)
+    numbers = ("band", "still", "settle", "timeout")
+    given: dict[str, Any] = {
+        key: check.number(table, key, where) for key in table if key in numbers
+    }
     for key, value in given.items():
         if not value > 0:
             raise check.fail(where, f"{key!r} must be greater than 0, not {value}")
+    if "stop" in table:
+        if table["stop"] not in ("low", "high"):
+            raise check.fail(where, f'\'stop\' must be "low" or "high", not {table["stop"]!r}')
+        given["stop"] = table["stop"]
+    if "free_travel" in table:
+        given["free_travel"] = _free_travel(check, table["free_travel"], channels, where)
     try:
         return ArrivalConfig(**given)
     except StationError as error:
         raise check.fail(where, error.message.rstrip(".")) from None
+
+
+def _free_travel(
+    check: Checker, value: Any, channels: tuple[str, ...], where: str
+) -> dict[str, float]:
+    """``free_travel``: one finite number for every channel, or a table of them by channel."""
+    table = value if isinstance(value, Mapping) else dict.fromkeys(channels, value)
+    unknown = [str(c) for c in table if c not in channels]
+    if unknown:
+        raise check.fail(
+            where, f"'free_travel' names {', '.join(unknown)}, not a channel of this procedure"
+        )
+    stops = {}
+    for channel, number in table.items():
+        if isinstance(number, bool) or not isinstance(number, int | float):
+            raise check.fail(where, f"'free_travel' of {channel} must be a number")
+        if not math.isfinite(number):
+            raise check.fail(where, f"'free_travel' of {channel} must be finite, not {number}")
+        stops[str(channel)] = float(number)
+    return stops
 
 
 def _analysis_kind(

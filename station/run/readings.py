@@ -7,6 +7,7 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
+from station.instruments.capture import at_stop_sentence
 from station.instruments.units import unit_mismatch
 from station.session.model import event_seconds
 
@@ -41,6 +42,9 @@ def set_problem(result: CaptureResult, needed: Sequence[str], unit: str) -> str:
     duplicated = [c for c in needed if c in result.duplicated]
     if duplicated:
         problems.append("more than one reading from " + ", ".join(duplicated))
+    at_stop = [c for c in needed if c in result.at_stop]
+    if at_stop:
+        problems.append(at_stop_sentence(at_stop))
     mismatch = unit_mismatch(result.readings, needed, unit)
     if mismatch:
         problems.append(mismatch)

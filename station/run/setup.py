@@ -177,6 +177,8 @@ class SessionSetup:
             "still": arrival.still,
             "settle": arrival.settle,
             "timeout": arrival.timeout,
+            "stop": arrival.stop,
+            **({"free_travel": dict(arrival.free_travel)} if arrival.free_travel else {}),
         }
 
     def header_fields(self) -> dict[str, Any]:

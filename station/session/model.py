@@ -298,10 +298,13 @@ def replay_bytes(data: bytes, path: Path, *, allow_torn: bool) -> tuple[Replay, 
     if not looks_like_session(data):
         raise not_a_session_error(path, empty=not data)
     split = _split(data)
+    torn = None
     if split.torn_reason and not allow_torn:
-        raise SessionFileError(path, len(split.lines) + 1, f"torn: {split.torn_reason}")
+        torn = SessionFileError(path, len(split.lines) + 1, f"torn: {split.torn_reason}")
     if not split.lines:
-        raise SessionFileError(path, 1, "no complete header line (cut while being created?)")
+        raise torn or SessionFileError(
+            path, 1, "no complete header line (cut while being created?)"
+        )
     replay = Replay()
     for number, line in enumerate(split.lines, start=1):
         try:
@@ -315,6 +318,10 @@ def replay_bytes(data: bytes, path: Path, *, allow_torn: bool) -> tuple[Replay, 
         except ValueError as error:
             raise SessionFileError(path, number, str(error)) from None
         replay.apply(record, line)
+    # The torn tail is the first bad line only when every line before it holds: a newline
+    # written into the last line leaves a bad complete line before the "torn" rest of it.
+    if torn is not None:
+        raise torn
     return replay, len(split.lines), split
 
 

@@ -21,6 +21,7 @@ import contextlib
 import hashlib
 import os
 import stat
+import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -113,6 +114,9 @@ def station_key(create: bool = True) -> StationKey | None:
 
 
 def _make_key(path: Path) -> StationKey:
+    """Make the key and put it in place whole: written to a file of its own, then linked to
+    ``path`` (which fails if another session made one first: that one is used). A reader never
+    sees a half-written key."""
     private = Ed25519PrivateKey.generate()
     pem = private.private_bytes(
         serialization.Encoding.PEM,
@@ -121,12 +125,7 @@ def _make_key(path: Path) -> StationKey:
     )
     try:
         path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
-        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o600)
-    except FileExistsError:
-        # Another process made it first: use that one.
-        key = station_key(create=False)
-        assert key is not None
-        return key
+        fd, draft = tempfile.mkstemp(prefix=".signing-key-", dir=path.parent)
     except OSError as error:
         raise StationError(
             f"cannot make the station's signing key in {path.parent}: {error.strerror}"
@@ -135,14 +134,23 @@ def _make_key(path: Path) -> StationKey:
         os.fchmod(fd, 0o600)
         os.write(fd, pem)
         os.fsync(fd)
-    except OSError as error:
         os.close(fd)
-        with contextlib.suppress(OSError):
-            path.unlink()
+        fd = -1
+        os.link(draft, path)
+    except FileExistsError:
+        # Another session made it first: use that one.
+        key = station_key(create=False)
+        assert key is not None
+        return key
+    except OSError as error:
         raise StationError(
             f"cannot write the station's signing key {path}: {error.strerror}"
         ) from None
-    os.close(fd)
+    finally:
+        if fd >= 0:
+            os.close(fd)
+        with contextlib.suppress(OSError):
+            os.unlink(draft)
     return StationKey(private, _raw_public(private))
 
 

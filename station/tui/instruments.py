@@ -6,7 +6,6 @@ reader); nothing here parses a frame or writes a file.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -16,9 +15,6 @@ from station.text import format_value
 
 DEMO_PROTOCOL = "mitutoyo"
 TEST_CAPTURES = 5
-REST_START_SLACK = 0.05
-"""A zero may begin this part of a period after the simulated robot came to rest (its dwell
-is 0.35 of the period; the zero needs its settle time of stillness within it)."""
 DEMO_GAUGE_NOISE = 0.3
 """The demo indicators' own reading noise, in resolutions (σ): a robot at rest looks at rest."""
 
@@ -84,25 +80,13 @@ class DemoFixture:
         if rest != simulator.rest:
             simulator.move_to_rest(rest)
 
-    def wait_at_rest(self) -> None:
-        """Block until the simulated robot has just come to rest at the fixture, as a
-        technician stops a real robot there before zeroing (a zero taken while it is away
-        would zero the indicators at their free travel, and every later cycle would be taken
-        away from the fixture); at once when the simulated robot does not move. At most one
-        period; call it from a worker thread."""
-        motion = getattr(self.simulator, "motion", None)
-        if motion is None:
-            return
-        now = time.monotonic() - self.simulator.motion_t0
-        start, _ = motion.rest_window(int(now // motion.period))
-        if now - start > REST_START_SLACK * motion.period:
-            start, _ = motion.rest_window(int(now // motion.period) + 1)
-        if start > now:
-            time.sleep(start - now)
-
     def stop(self) -> None:
         """Close the pseudo-terminal and stop the simulator's thread."""
-        _RUNNING.pop(self.url, None)
+        # Only this fixture's own entry: the kernel gives a closed /dev/pts/N to the next
+        # pseudo-terminal opened, and a second stop of a stale fixture would otherwise untrack
+        # the new set-up that now serves that path.
+        if _RUNNING.get(self.url) is self:
+            del _RUNNING[self.url]
         self.simulator.stop()
 
 
@@ -113,7 +97,12 @@ robot where the steps say (:meth:`DemoFixture.follow`)."""
 
 def track(fixture: DemoFixture) -> DemoFixture:
     """Follow ``fixture`` (a simulated set-up started in this process) in the sessions that
-    use its URL, until it stops."""
+    use its URL, until it stops: from now on the procedure's steps play its robot."""
+    # ``station simulate``'s still robot moves to its next rest after a pause in the polls
+    # (``return_gap``), standing in for an operator nobody plays. Followed, it must not move
+    # as well: a slow screen between the frames check and the zero (a loaded machine) would
+    # move it off the plate, and the zero would be taken on the block.
+    fixture.simulator.return_gap = None
     _RUNNING[fixture.url] = fixture
     return fixture
 

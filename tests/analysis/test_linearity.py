@@ -32,6 +32,7 @@ from station.analysis.strokes import (
 from station.analysis.summary import AnalysisConfig
 from station.errors import StationError
 from station.instruments.simulator import BarModel, GaugeSpec
+from tests.properties import examples
 
 
 def brute_force_zone(s: np.ndarray, d: np.ndarray) -> float:
@@ -129,7 +130,7 @@ profiles = st.integers(min_value=2, max_value=9).flatmap(
 )
 
 
-@settings(max_examples=150, deadline=None, derandomize=True)
+@settings(max_examples=examples(150), deadline=None, derandomize=True)
 @given(profiles)
 def test_minimum_zone_matches_brute_force_and_never_exceeds_least_squares(profile):
     s, d = (np.asarray(v, dtype=float) for v in profile)

@@ -10,9 +10,10 @@ from station.analysis.capability import SpecLimits, capability
 from station.analysis.charts import control_chart
 from station.analysis.descriptive import describe, histogram
 from station.analysis.rules import RULE_SETS, check_rules
+from tests.properties import examples
 
 # Deterministic and lean: the whole file runs in a few seconds.
-lean = settings(max_examples=150, deadline=None, derandomize=True, database=None)
+lean = settings(max_examples=examples(150), deadline=None, derandomize=True, database=None)
 
 # Gauge readings: quantised to a resolution, within a realistic span.
 resolutions = st.sampled_from([0.0001, 0.001, 0.01, 0.5])

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import run_station
 
 REPO = Path(__file__).resolve().parents[2]
 TABLE_2_1 = REPO / "sessions" / "examples" / "table-2-1.csv"
@@ -17,13 +18,8 @@ REPORT_LIMITS = ["--lsl", "-0.001", "--usl", "0.001", "--resolution", "0.0001"]
 
 
 def station(*args: str | Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [str(STATION), "analyze", *map(str, args)],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        cwd=REPO,
-    )
+    """``station analyze ARGS``, in this process (test_analyze_honesty runs the real one)."""
+    return run_station("analyze", *args, cwd=REPO)
 
 
 def write_csv(folder: Path, name: str, text: str) -> Path:

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import run_station
 
 from station.instruments.joint_model import faulty_arm
 
@@ -17,9 +18,8 @@ STATION = Path(sys.executable).parent / "station"
 
 
 def analyze(*args: str | Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [str(STATION), "analyze", *map(str, args)], capture_output=True, text=True, timeout=60
-    )
+    """``station analyze ARGS``, in this process (test_analyze_honesty runs the real one)."""
+    return run_station("analyze", *args)
 
 
 @pytest.fixture()

@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from helpers import run_station
 
 from station.analysis.strokes import split_strokes
 from station.instruments.simulator import BarModel, TwoFixtureModel
@@ -18,13 +19,8 @@ STATION = Path(sys.executable).parent / "station"
 
 
 def station(*args: str | Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [str(STATION), "analyze", *map(str, args)],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        cwd=REPO,
-    )
+    """``station analyze ARGS``, in this process (test_analyze_honesty runs the real one)."""
+    return run_station("analyze", *args, cwd=REPO)
 
 
 @pytest.fixture(scope="module")

@@ -9,20 +9,24 @@ import sys
 from pathlib import Path
 
 import pytest
+from helpers import run_station
 
 REPO = Path(__file__).resolve().parents[2]
 
 
 def station(*args: str | Path, timeout: float = 30, **kwargs) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "station", *map(str, args)],
-        capture_output=True,
-        text=True,
-        cwd=REPO,
-        env={**os.environ, "STATION_PROCEDURES": ""},
-        timeout=timeout,
-        **kwargs,
-    )
+    """``station ARGS`` in this process; in a real one for the full-screen commands and where
+    the test hands the process its own streams (``kwargs``)."""
+    if kwargs or str(args[0]) in ("demo", "tui"):
+        return subprocess.run(
+            [sys.executable, "-m", "station", *map(str, args)],
+            capture_output=True,
+            text=True,
+            cwd=REPO,
+            timeout=timeout,
+            **kwargs,
+        )
+    return run_station(*args, cwd=REPO)
 
 
 def one_sentence(result: subprocess.CompletedProcess, code: int = 2, *words: str) -> None:

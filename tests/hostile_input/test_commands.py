@@ -16,6 +16,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from helpers import run_station
 from hostile import (
     HOSTILE_PROCEDURE,
     LONG,
@@ -32,14 +33,8 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 def station(*args: str | Path, env: dict | None = None, timeout: float = 60):
-    return subprocess.run(
-        [sys.executable, "-m", "station", *map(str, args)],
-        capture_output=True,
-        text=True,
-        cwd=REPO,
-        env={**os.environ, "STATION_PROCEDURES": "", **(env or {})},
-        timeout=timeout,
-    )
+    """``station ARGS`` in this process, with ``env`` added to the environment."""
+    return run_station(*args, cwd=REPO, env={**os.environ, **(env or {})})
 
 
 def assert_plain(result: subprocess.CompletedProcess[str]) -> None:

@@ -7,6 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from station.instruments.framing import FrameSplitter, Overflow
+from tests.properties import examples
 
 
 def feed_all(splitter: FrameSplitter, *chunks: bytes) -> list[bytes | Overflow]:
@@ -136,7 +137,7 @@ _stream_bytes = st.lists(
 ).map(b"".join)
 
 
-@settings(max_examples=300, derandomize=True, deadline=None)
+@settings(max_examples=examples(300), derandomize=True, deadline=None)
 @given(
     stream=_stream_bytes,
     terminator=st.sampled_from([b"\r", b"\n", b"\r\n", b";", b"\x03\x04"]),

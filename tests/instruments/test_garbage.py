@@ -33,6 +33,7 @@ from hypothesis import strategies as st
 from station.instruments.base import Value
 from station.instruments.framing import FrameSplitter
 from station.instruments.protocols import get_protocol, protocol_names
+from tests.properties import examples
 
 MAX_FRAME = 32
 
@@ -130,7 +131,7 @@ def _cut(stream: bytes, sizes: list[int]) -> list[bytes]:
 
 
 @settings(
-    max_examples=10_000,
+    max_examples=examples(10_000),
     derandomize=True,
     database=None,
     deadline=None,

@@ -91,7 +91,9 @@ def test_arrival_takes_one_set_per_round_trip_at_rest_spaced_by_the_period() -> 
     assert all(result.trigger == "arrival" and result.complete for result, _ in sets)
     times = [result.readings["x"].t_mono for result, _ in sets]
     gaps = [b - a for a, b in zip(times, times[1:], strict=False)]
-    assert all(abs(gap - PERIOD) < 0.1 for gap in gaps), gaps
+    # One period apart, give or take a settle window or two: under load a late poll restarts
+    # the stillness a set waits for (readings more than half a settle time apart prove none).
+    assert all(abs(gap - PERIOD) < 0.15 for gap in gaps), gaps
     # One departure before each set, and each set a settle time after its arrival.
     assert "unsettled" not in [event.kind for event in events]
     departures = [sum(e.kind == "departed" for e in seen) for _, seen in sets]

@@ -14,6 +14,7 @@ from station.errors import StationError
 from station.instruments.base import Rejected, SerialSettings, Value
 from station.instruments.framing import FrameSplitter
 from station.instruments.protocols import PROTOCOLS, as_bytes, get_protocol, protocol_names
+from tests.properties import examples
 
 # (protocol, frame without terminator, expected device channel, value, unit)
 GOLDEN_READINGS = [
@@ -236,7 +237,7 @@ RESOLUTIONS = [0.01, 0.005, 0.002, 0.001, 0.0005, 0.0001, 0.00005, 0.00001]
 UNIT_IN_FRAME = {"uwave", "cdi", "digimatic"}
 
 
-@settings(max_examples=400, derandomize=True, deadline=None)
+@settings(max_examples=examples(400), derandomize=True, deadline=None)
 @given(
     name=st.sampled_from(protocol_names()),
     counts=st.integers(-99_999, 99_999),
@@ -272,7 +273,7 @@ _frame_bytes = st.lists(
 ).map(b"".join)
 
 
-@settings(max_examples=500, derandomize=True, deadline=None)
+@settings(max_examples=examples(500), derandomize=True, deadline=None)
 @given(
     name=st.sampled_from(protocol_names()), frame=st.one_of(st.binary(max_size=40), _frame_bytes)
 )

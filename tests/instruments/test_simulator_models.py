@@ -19,6 +19,7 @@ from station.instruments.base import Value
 from station.instruments.framing import FrameSplitter
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import BarModel, GaugeSpec, Simulator, TwoFixtureModel
+from tests.clock import ManualClock
 
 
 def read_values(fd: int, protocol, count: int, timeout: float = 10.0) -> list[Value]:
@@ -147,10 +148,10 @@ def test_readings_follow_the_robots_rest_home_then_each_return():
         TwoFixtureModel(captures=0)
 
 
-def serve_two_fixtures(seed: int = 4):
+def serve_two_fixtures(seed: int = 4, clock=time.monotonic):
     protocol = get_protocol("mitutoyo")
     model = TwoFixtureModel(captures=1, preload=0.05, noise=0.0002, seed=9)
-    sim = Simulator(protocol, model, seed=seed)
+    sim = Simulator(protocol, model, seed=seed, clock=clock)
     path = sim.start_pty()
     return protocol, model, sim, os.open(path, os.O_RDWR | os.O_NOCTTY)
 
@@ -216,15 +217,20 @@ def request_set(fd: int, protocol, sim: Simulator) -> dict[str, list[float]]:
 def test_a_pause_in_the_polls_is_the_operator_moving_the_robot():
     """``station simulate``'s still robot: polls close together (the frames check, a zero's
     readings) read one rest; after a pause of ``return_gap`` the robot is at its next rest (the
-    placement's return, then the next placement's home)."""
-    protocol, model, sim, fd = serve_two_fixtures()
+    placement's return, then the next placement's home). The clock is the test's: the polls of
+    one rest are close together however busy the machine is."""
+    clock = ManualClock()
+    protocol, model, sim, fd = serve_two_fixtures(clock=clock)
     sim.return_gap = 0.3
     try:
         tty.setraw(fd)
-        home = [request_set(fd, protocol, sim) for _ in range(6)]  # frames check + a zero
-        time.sleep(0.4)
+        home = []
+        for _ in range(6):  # frames check + a zero
+            home.append(request_set(fd, protocol, sim))
+            clock.advance(0.01)
+        clock.advance(0.4)
         back = request_set(fd, protocol, sim)
-        time.sleep(0.4)
+        clock.advance(0.4)
         next_home = request_set(fd, protocol, sim)
     finally:
         os.close(fd)

@@ -58,3 +58,25 @@ def test_faults_name_the_file_and_the_place(tmp_path: Path, extra, zero_extra, f
     with pytest.raises(StationError, match=fault) as caught:
         load_procedure(path)
     assert str(path) in caught.value.message
+
+
+def test_the_indicators_stop_and_its_reading_are_kept(tmp_path: Path) -> None:
+    text = HEAD + '\n[arrival]\nstop = "high"\nfree_travel = 0.375\n' + ZERO
+    procedure = load_procedure(write(tmp_path, text))
+    assert procedure.arrival.stop == "high"
+    assert procedure.arrival.free_travel == dict.fromkeys(procedure.channels, 0.375)
+
+
+@pytest.mark.parametrize(
+    ("extra", "fault"),
+    [
+        ('\n[arrival]\nstop = "left"\n', r"'stop' must be \"low\" or \"high\", not 'left'"),
+        ("\n[arrival]\nfree_travel = { q = 1.0 }\n", r"'free_travel' names q, not a channel"),
+        ('\n[arrival]\nfree_travel = "far"\n', r"'free_travel' of \w+ must be a number"),
+        ("\n[arrival]\nfree_travel = inf\n", r"'free_travel' of \w+ must be finite"),
+    ],
+)
+def test_a_wrong_stop_is_refused_naming_the_place(tmp_path: Path, extra, fault) -> None:
+    path = write(tmp_path, HEAD + extra + ZERO)
+    with pytest.raises(StationError, match=fault):
+        load_procedure(path)

@@ -251,6 +251,7 @@ def test_a_site_procedure_overrides_the_builtin_one_and_says_so(tmp_path, monkey
     assert discover_procedures().get("repeatability").version == "site-7"
 
 
+@pytest.mark.slow  # builds the wheel
 def test_a_wheel_carries_the_builtin_procedures(tmp_path: Path) -> None:
     # Build from a copy so the build's own files never touch the working tree.
     source = tmp_path / "src"

@@ -17,15 +17,6 @@ AXES = ("x", "y", "z")
 WHEN = datetime(2026, 11, 23, 12, 0, 0, tzinfo=UTC)
 
 
-@pytest.fixture(autouse=True)
-def private_folders(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """Every test of the record gets its own data and config folders (baselines live there)."""
-    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "config"))
-    monkeypatch.delenv("STATION_SESSIONS", raising=False)
-    monkeypatch.delenv("STATION_PROCEDURES", raising=False)
-
-
 def header_fields(procedure_id: str, *, robot: str, operator: str = "ana", **setup) -> dict:
     """The header fields of a session of a built-in procedure on one simulated port."""
     procedure = discover_procedures(use_env=False).get(procedure_id)

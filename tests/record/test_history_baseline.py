@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 from datetime import UTC, datetime, timedelta
+from pathlib import Path
 
 import pytest
 
@@ -92,7 +93,7 @@ def test_baseline_is_stored_loaded_marked_and_cleared(sessions, capsys):
     x = record["channels"]["x"]
     assert x["lcl"] < x["center"] < x["ucl"] and x["mr_ucl"] > 0
     assert record["anchor"] in paths[1].read_text()
-    assert baseline_path("KSC-7").parent.parent.parent == sessions.parent / "data"
+    assert baseline_path("KSC-7").parent.parent.parent == Path(os.environ["XDG_DATA_HOME"])
 
     history = robot_history(sessions, "KSC-7")
     assert [e.baseline for e in history.entries] == [False, True, False, False, False]

@@ -104,6 +104,7 @@ def artefacts(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return tmp_path_factory.mktemp("report-artefacts")
 
 
+@pytest.mark.slow  # a real browser
 @pytest.mark.skipif(CHROMIUM is None, reason="chromium-headless-shell is not installed")
 @pytest.mark.parametrize("kind", list(BUILDERS))
 def test_html_report_opens_in_chromium_with_its_charts(kind, sessions, artefacts):
@@ -124,6 +125,7 @@ def test_html_report_opens_in_chromium_with_its_charts(kind, sessions, artefacts
     assert dom.count('class="chart"') == EXPECTED_CHARTS[kind]
 
 
+@pytest.mark.slow  # a real browser
 @pytest.mark.skipif(CHROMIUM is None, reason="chromium-headless-shell is not installed")
 def test_chromium_check_sees_a_page_that_reaches_outside(tmp_path):
     """The console check above can fail: a page loading an outside image is reported."""

@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from helpers import run_station
 
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import AxisModel, GaugeSpec, Simulator, fixture_model
@@ -21,16 +22,9 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 def station(*args: str, timeout: float = 60) -> subprocess.CompletedProcess[str]:
-    """Run ``station`` in a subprocess (no site procedures from the environment)."""
-    return subprocess.run(
-        [sys.executable, "-m", "station", *args],
-        stdin=subprocess.DEVNULL,  # a script: never a terminal to ask an alarm's cause at
-        capture_output=True,
-        text=True,
-        cwd=REPO,
-        env={**os.environ, "STATION_PROCEDURES": ""},
-        timeout=timeout,
-    )
+    """Run ``station`` in this process, as a script: no terminal to ask an alarm's cause at
+    (the tests below that are about the terminal or the process run the real one)."""
+    return run_station(*args, cwd=REPO)
 
 
 @pytest.fixture

@@ -9,10 +9,10 @@ import json
 import os
 import stat
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from helpers import run_station
 
 from station.cli import main
 from station.errors import StationError
@@ -27,13 +27,8 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 def station(*args: str | Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "station", *map(str, args)],
-        capture_output=True,
-        text=True,
-        cwd=REPO,
-        timeout=60,
-    )
+    """``station ARGS`` in this process."""
+    return run_station(*args, cwd=REPO)
 
 
 # -- finding 3: writes follow planted symlinks -------------------------------------------------

@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 from station.errors import StationError
 from station.session.model import load_session
 from station.session.verify import verify_session
+from tests.properties import examples
 
 from .conftest import write_session
 
@@ -21,7 +22,7 @@ with tempfile.TemporaryDirectory(prefix="station-tamper-") as _folder:
     DATA = write_session(Path(_folder), cycles=4).read_bytes()
 
 
-@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(300), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(position=st.integers(0, len(DATA) - 1), flip=st.integers(1, 255))
 def test_any_single_flipped_byte_fails_verify_and_names_its_line(position: int, flip: int) -> None:
     damaged = bytearray(DATA)
@@ -35,6 +36,22 @@ def test_any_single_flipped_byte_fails_verify_and_names_its_line(position: int, 
     assert f"line {result.first_bad_line}:" in result.message
 
 
+def test_a_newline_written_into_the_last_line_names_the_last_line() -> None:
+    """Found by the property above (about one run in 80): a byte of the last line's hash flipped
+    to a newline split it in two, and verify named the torn piece after it (line 15), not the
+    damaged line 14 before it. Every byte of the last line, turned into a newline."""
+    last = DATA.count(b"\n")
+    start = DATA.rstrip(b"\n").rfind(b"\n") + 1
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "s.jsonl"
+        for position in range(start, len(DATA) - 1):
+            damaged = bytearray(DATA)
+            damaged[position] = ord("\n")
+            path.write_bytes(bytes(damaged))
+            result = verify_session(path)
+            assert (result.ok, result.first_bad_line) == (False, last), (position, result.message)
+
+
 def _load_or_station_error(data: bytes) -> None:
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "s.jsonl"
@@ -45,13 +62,13 @@ def _load_or_station_error(data: bytes) -> None:
             verify_session(path)
 
 
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=examples(150), deadline=None)
 @given(st.binary(max_size=600))
 def test_the_loader_only_raises_station_error_on_arbitrary_bytes(data: bytes) -> None:
     _load_or_station_error(data)
 
 
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=examples(150), deadline=None)
 @given(
     edits=st.lists(
         st.tuples(

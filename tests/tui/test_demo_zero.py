@@ -1,7 +1,8 @@
 """The demo's robot never stops moving: Enter at the zero step while it is away from the
 fixture zeroed the indicators at their free travel (-0.375 in), and every later "cycle" was then
-taken away from the fixture (all +0.00000). The demo now zeroes when the simulated robot has
-just come to rest at the fixture, as a technician stops a real robot there."""
+taken away from the fixture (all +0.00000). The engine now zeroes only with the robot at rest at
+the fixture (never at the plungers' stop), whichever front end asks and whenever Enter is
+pressed: here while the robot is away, approaching, or just about to leave."""
 
 from __future__ import annotations
 
@@ -28,14 +29,18 @@ def moving_lab() -> Iterator[DemoLab]:
         lab.stop()
 
 
-def _away(lab: DemoLab) -> bool:
+def _in_stage(lab: DemoLab, wanted: str, after: float = 0.0) -> bool:
+    """True when the demo's robot is in stage ``wanted``, at least ``after`` into it."""
     simulator = lab.fixture("repeatability").simulator
-    stage = simulator.motion.stage(time.monotonic() - simulator.motion_t0)[1]
-    return stage == "away"
+    _, stage, into = simulator.motion.stage(time.monotonic() - simulator.motion_t0)
+    return stage == wanted and into >= after
 
 
-async def test_enter_at_the_zero_step_while_the_robot_is_away_zeroes_at_the_fixture(
-    tmp_path: Path, moving_lab: DemoLab, tui
+@pytest.mark.parametrize(
+    ("stage", "after"), [("away", 0.0), ("approaching", 0.0), ("at rest", 0.8)]
+)
+async def test_enter_at_the_zero_step_at_any_moment_zeroes_at_the_fixture(
+    tmp_path: Path, moving_lab: DemoLab, tui, stage: str, after: float
 ) -> None:
     from station.tui.screens.checklist import ChecklistScreen
 
@@ -66,8 +71,8 @@ async def test_enter_at_the_zero_step_while_the_robot_is_away_zeroes_at_the_fixt
                 pilot, lambda before=before: app.runner.state().current.index != before
             )
         await tui.wait_until(pilot, lambda: not app.screen.busy)
-        # Enter while the simulated robot is away from the fixture.
-        await tui.wait_until(pilot, lambda: _away(moving_lab), timeout=3 * PERIOD)
+        # Enter at that moment of the simulated robot's loop.
+        await tui.wait_until(pilot, lambda: _in_stage(moving_lab, stage, after), timeout=3 * PERIOD)
         app.screen.action_confirm()
         await tui.wait_until(
             pilot, lambda: app.runner.state().action.kind != "zero", timeout=4 * PERIOD

@@ -176,6 +176,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--timeout", default="5", metavar="S", help="seconds to wait for a reading set (5)"
     )
     parser.add_argument(
+        "--idle-report",
+        default="30",
+        metavar="S",
+        help="while the robot or DATA presses set the pace (arrival, push), say what the "
+        "gauges see after S seconds without a zero or a cycle, and every S seconds after (30)",
+    )
+    parser.add_argument(
         "--attempts",
         default="3",
         metavar="N",

@@ -66,6 +66,7 @@ def run(args: argparse.Namespace) -> int:
     if timeout > 86_400:  # a bound time.monotonic() arithmetic and Event.wait() both take
         raise StationError(f"--timeout must be at most 86400 seconds (a day), not {args.timeout}.")
     attempts = positive_number(args.attempts, "--attempts", int)
+    idle_report = positive_number(args.idle_report, "--idle-report")
     inputs = parse_inputs(args.input, args.inputs)
     deadband = positive_number(args.deadband, "--deadband") if args.deadband else None
     still = positive_number(args.still, "--still")
@@ -121,6 +122,7 @@ def run(args: argparse.Namespace) -> int:
             still=still,
             every=every,
             enter=enter,
+            idle_report=idle_report,
         )
         worker = threading.Thread(target=headless.run, name="station capture", daemon=True)
         worker.start()

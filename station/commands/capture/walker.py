@@ -11,7 +11,7 @@ from typing import Any
 
 from station.commands.capture.inputs import Inputs, values_for
 from station.errors import StationError
-from station.instruments.zeroing import GaugesMoving
+from station.instruments.zeroing import GaugesMoving, NotAtFixture
 
 BY = "station capture"
 """Who confirmed what the command did, as the session file records it."""
@@ -35,9 +35,14 @@ class Headless:
         still: float = 2.0,
         every: float | None = None,
         enter: bool = False,
+        idle_report: float = 30.0,
     ) -> None:
         self.runner = runner
         self.every = every
+        self.idle_report = idle_report
+        """Seconds without a zero or a cycle after which a capture paced by the devices
+        (arrival, push) says what the gauges see, and again every so long: a robot that
+        stopped, or indicators that never see the cube, must not look like a working capture."""
         self.enter = enter
         self._last_capture = float("-inf")
         self._moving_since: float | None = None
@@ -52,6 +57,8 @@ class Headless:
         self.push = runner.setup.trigger == "push"
         self._waiting = False
         self._refused = 0
+        self._since_set = time.monotonic()
+        self._reported_at = self._since_set
 
     def run(self) -> None:
         try:
@@ -68,9 +75,11 @@ class Headless:
         pressed DATA, which with the push trigger is waiting, not a refused set."""
         return sum(reader.reading_count for reader in getattr(self.runner.gauges, "readers", ()))
 
-    def _idle(self, step: Any) -> None:
+    def _idle(self, step: Any, seen: str | None = None) -> None:
         """Nobody pressed DATA (or the robot did not come back) during a wait: say once, until
-        the next set, that the command waits (the operator or the robot sets the pace)."""
+        the next set, that the command waits (the operator or the robot sets the pace); and
+        every ``idle_report`` seconds without a cycle, what the gauges see (``seen``, else
+        the gauges' own sentence)."""
         if not self._waiting:
             what = "press DATA" if self.push else "run the robot's playback loop"
             print(
@@ -79,6 +88,25 @@ class Headless:
                 flush=True,
             )
         self._waiting = True
+        now = time.monotonic()
+        if now - self._reported_at < self.idle_report:
+            return
+        self._reported_at = now
+        if seen is None:
+            seen = getattr(self.runner.gauges, "waiting_sentence", lambda: "")()
+        check = (
+            "check that DATA is pressed and the gauges' cables"
+            if self.push
+            else "check that the robot's playback loop runs and that the cube reaches every "
+            "indicator at the taught point"
+        )
+        print(
+            f"station: nothing taken for {now - self._since_set:.0f} s (step {step.title!r})"
+            + (f": {seen}" if seen else "")
+            + f"; {check}.",
+            file=sys.stderr,
+            flush=True,
+        )
 
     def _pace(self, state: Any) -> bool:
         """Poll: wait out ``--every`` since the last capture, or for Enter at the terminal
@@ -126,6 +154,16 @@ class Headless:
         seen = self._readings_seen()
         try:
             self.runner.zero(by=BY, timeout=self.timeout)
+        except NotAtFixture as away:
+            # The robot on its loop is not at rest at the fixture yet: the zero waits for it
+            # as the cycles do (the robot sets the pace), said once and then every
+            # idle_report seconds with what the gauges see.
+            if self._moving_since is None:
+                self._moving_since = time.monotonic()
+                print(f"station: waiting: {away.message}", file=sys.stderr, flush=True)
+            self._waiting = True  # said just now
+            self._idle(state.current.step, away.message.removeprefix("Could not zero yet: "))
+            return
         except GaugesMoving as moving:
             # The robot is not at rest at the fixture yet: zero once it is (said once), for as
             # long as --attempts waits of --timeout; then the run stops, resumable.
@@ -150,7 +188,7 @@ class Headless:
         self._waiting = False
         self._moving_since = None
         # The robot is started on its loop once it is zeroed: the first cycle is paced too.
-        self._last_capture = time.monotonic()
+        self._last_capture = self._since_set = self._reported_at = time.monotonic()
 
     def _stream(self, state: Any) -> None:
         if state.progress is not None and state.progress.complete:
@@ -177,6 +215,7 @@ class Headless:
             return
         if outcome.recorded:
             self._refused = 0
+            self._since_set = self._reported_at = time.monotonic()
         elif outcome.waited and not self.push:
             self._idle(state.current.step)  # the robot has not come back yet: it sets the pace
             return

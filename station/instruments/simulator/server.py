@@ -97,6 +97,7 @@ class Simulator:
         answer_delay: float = 0.0,
         motion: CycleMotion | None = None,
         returns_each_set: bool = False,
+        clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.protocol = protocol
         self.model = model
@@ -106,6 +107,11 @@ class Simulator:
         self.motion = motion
         """The robot's round trips (:mod:`~station.instruments.motion`); None: every reading is
         a new rest position (the k-th reading of the model)."""
+        self.clock = clock
+        """The robot's time (seconds, monotonic): its motion, the pause in the polls that moves
+        a still robot, the first rest's hold and the times of :attr:`sent`. A test passes a
+        clock it advances itself, so that what the robot does never depends on the machine's
+        load; the line's own pacing (pushes, disconnects) keeps real time."""
         self.motion_t0 = 0.0
         self.return_gap: float | None = None
         """When set (a still robot, polled): the operator moves the robot to its next rest
@@ -128,7 +134,7 @@ class Simulator:
         however often the gauges are read, and steps on :meth:`robot_returns` /
         :meth:`move_to_rest`. Every reading at a rest shows the model's rest position plus the
         indicator's own noise."""
-        """``time.monotonic()`` when serving started: the origin of the motion's time."""
+        """:attr:`clock` when serving started: the origin of the motion's time."""
         self.answer_delay = answer_delay
         if channel_map is None:
             own = tuple(protocol.channels)
@@ -219,7 +225,7 @@ class Simulator:
 
     def _start_thread(self) -> None:
         self._stopping.clear()
-        self.motion_t0 = time.monotonic()
+        self.motion_t0 = self.clock()
         self._thread = threading.Thread(target=self._serve, name="gauge-simulator", daemon=True)
         self._thread.start()
 
@@ -349,7 +355,7 @@ class Simulator:
                 for device in devices:
                     self._zero(self.channel_map[device])
                 continue
-            self._asked(time.monotonic())
+            self._asked(self.clock())
             if self.answer_delay:
                 time.sleep(self.answer_delay)
             for device in devices:
@@ -420,7 +426,7 @@ class Simulator:
         channel = self.channel_map[device]
         gauge = self.model.gauge(channel)
         k = self._k[channel]
-        now = time.monotonic()
+        now = self.clock()
         if self.motion is not None:
             cycle = self.motion.stage(now - self.motion_t0)[0]
             value = self.expected_at(channel, now, k)
@@ -446,7 +452,7 @@ class Simulator:
         if not delivered:
             return  # the line is down: this value was never seen, and k is not used up
         self._k[channel] = k + 1
-        self.sent[channel].append(SentFrame(channel, k, value, frame, time.monotonic(), cycle))
+        self.sent[channel].append(SentFrame(channel, k, value, frame, self.clock(), cycle))
         if self.on_sent is not None:
             self.on_sent(channel, k)
         if stale and self._recent:
@@ -513,7 +519,7 @@ class Simulator:
         self.zero_requests.append(channel)
         if self.motion is not None:
             # A moving robot's gauge zeroes on what it shows at this instant.
-            self.zero_offsets[channel] = self.shown_at(channel, time.monotonic())
+            self.zero_offsets[channel] = self.shown_at(channel, self.clock())
             return
         reference = self.model.zero_reference(channel, self.rest, self.seed)
         if reference is None:

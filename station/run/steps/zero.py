@@ -85,6 +85,9 @@ class ZeroStep(StepHandler):
             with run.lock:
                 run.release()
             raise
+        # Where each plunger rests free, as far as the gauges know it: the record shows the
+        # zero was taken away from it.
+        stops = run.gauges.stops()
         with run.lock:
             run.release()
             run.ensure_open()
@@ -93,7 +96,11 @@ class ZeroStep(StepHandler):
                 step=item.step.id,
                 placement=item.placement,
                 channels={
-                    result.channel: {**result.record(), "uncertainty": result.uncertainty}
+                    result.channel: {
+                        **result.record(),
+                        "uncertainty": result.uncertainty,
+                        **({"stop": stops[result.channel]} if result.channel in stops else {}),
+                    }
                     for result in results
                 },
                 by=by,

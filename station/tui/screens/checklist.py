@@ -30,6 +30,16 @@ if TYPE_CHECKING:
     from station.run import Action, RunnerState, StepView
     from station.tui.app import StationApp
 
+ZERO_WAIT = 5.0
+"""Seconds a zero waits for the gauges (a port that is down, a gauge that moves)."""
+ARRIVAL_ZERO_WAIT = 30.0
+"""Under the arrival trigger, seconds a zero waits for the robot on its loop to come to rest
+at the fixture: a round trip or several."""
+
+ARRIVAL_ZERO_DOES = (
+    "Press Enter: the indicators are zeroed when the robot next comes to rest at the fixture "
+    "(seen coming back from away; never at the plungers' stop)."
+)
 ENTER_DOES = {
     "confirm": "Press Enter when this is done.",
     "zero": "Keep the robot still, then press Enter to zero the indicators.",
@@ -140,6 +150,9 @@ class ChecklistScreen(Screen[None]):
             text.append(shown_line(display.text), style="bold reverse")
         self.query_one("#step-text", Static).update(text)
         action = ENTER_DOES.get(asks, "Press Enter to continue.")
+        runner = self.app.runner
+        if asks == "zero" and runner is not None and runner.setup.trigger == "arrival":
+            action = ARRIVAL_ZERO_DOES
         if display is not None:
             action += f" (Demo: {display.hint}.)"
         elif self.app.config.demo is not None and asks != "input":
@@ -211,21 +224,15 @@ class ChecklistScreen(Screen[None]):
             }
             self._do(lambda: runner.submit_input(values))
         elif kind == "zero":
-            fixture = self.app.demo_fixture
-            if fixture is None:
-                self.query_one("#step-message", Static).update(Text("Zeroing ...", style="yellow"))
-                self._do(runner.zero)
-                return
-            # The demo's robot never stops: zero when it has just come to rest at the fixture.
-            self.query_one("#step-message", Static).update(
-                Text("Zeroing once the simulated robot is at rest at the fixture ...", "yellow")
-            )
-
-            def zero_at_rest() -> None:
-                fixture.wait_at_rest()
-                runner.zero()
-
-            self._do(zero_at_rest)
+            message = "Zeroing ..."
+            timeout = ZERO_WAIT
+            if runner.setup.trigger == "arrival":
+                # The robot runs its loop: the gauges wait for it to come to rest at the
+                # fixture (never at the plungers' stop), so give it a round trip or two.
+                message = "Zeroing once the robot is at rest at the fixture ..."
+                timeout = ARRIVAL_ZERO_WAIT
+            self.query_one("#step-message", Static).update(Text(message, style="yellow"))
+            self._do(lambda: runner.zero(timeout=timeout))
         else:
             self._do(runner.confirm)
 
