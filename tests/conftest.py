@@ -7,8 +7,10 @@ Every test starts from the same process state, whatever ran before it and on whi
   (``STATION_GAUGES``) are the test's alone, for it and every process it starts;
 * none of the developer's ``STATION_*`` settings, nor ``NO_COLOR``;
 * temporary folders on tmpfs (``/dev/shm``), where durability is not what a test can see;
-* the registries of step and analysis kinds as the station's own modules fill them (a kind a
-  test registers is gone after it);
+* every station module imported once (so the procedure loader knows the methods, which
+  ``station.methods`` tells it); the methods and the step kinds are explicit tuples, and a site's
+  own come from entry points scanned per ``sys.path``, so a test that installs one (on its own
+  ``sys.path``) leaves nothing behind;
 * no simulated set-up left followed from an earlier test (``station.tui.instruments``).
 """
 
@@ -52,9 +54,8 @@ if "TMPDIR" not in os.environ and os.access(SHARED_MEMORY, os.W_OK | os.X_OK):
 
 
 def _import_every_station_module() -> None:
-    """Import all of ``station`` once, so that every built-in kind has registered itself before
-    the registries are copied (a module first imported by a test would otherwise register its
-    kinds after the copy, and lose them at the next reset)."""
+    """Import all of ``station`` once (``station.methods`` among it tells the procedure loader
+    the methods' needs), as a running station has by the time it loads a procedure."""
     import station
 
     for module in pkgutil.walk_packages(station.__path__, "station."):
@@ -64,29 +65,10 @@ def _import_every_station_module() -> None:
 
 _import_every_station_module()
 
-from station.procedures import kinds as _procedure_kinds  # noqa: E402
-from station.run import steps as _steps  # noqa: E402
 from station.tui import instruments as _demo_instruments  # noqa: E402
-from station.verdicts import registry as _verdicts  # noqa: E402
-
-_REGISTRIES: tuple[dict, ...] = (
-    _verdicts._KINDS,
-    _steps._HANDLERS,
-    _procedure_kinds._STEP_SCHEMAS,
-    _procedure_kinds._ANALYSES,
-)
-"""The process-wide registries a test may add to, as the station's modules filled them."""
-_BUILT_IN = tuple(dict(registry) for registry in _REGISTRIES)
 
 PRIVATE_ENVIRONMENT = ("STATION_SESSIONS", "STATION_PROCEDURES", "STATION_THEME", "NO_COLOR")
 """The developer's settings that would change what a test sees; unset for every test."""
-
-
-def _reset_registries() -> None:
-    # In place: the station's functions hold these very dicts.
-    for registry, built_in in zip(_REGISTRIES, _BUILT_IN, strict=True):
-        registry.clear()
-        registry.update(built_in)
 
 
 def _stop_followed_fixtures() -> None:
@@ -108,9 +90,9 @@ def _matplotlib_folder(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Non
 def _private_process_state(
     tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch
 ) -> Iterator[None]:
-    """The test's own folders and settings and the station's registries as built (see the
-    module); set for the test and every process it starts. The folders are beside the test's
-    ``tmp_path``, not in it, so a test that lists its ``tmp_path`` sees only its own files."""
+    """The test's own folders and settings and no followed simulator (see the module); set
+    for the test and every process it starts. The folders are beside the test's ``tmp_path``,
+    not in it, so a test that lists its ``tmp_path`` sees only its own files."""
     home = tmp_path_factory.mktemp("home")
     monkeypatch.setenv("HOME", str(home))
     for variable, folder in (
@@ -124,8 +106,6 @@ def _private_process_state(
     monkeypatch.setenv("STATION_GAUGES", str(home / "gauges.json"))
     for variable in PRIVATE_ENVIRONMENT:
         monkeypatch.delenv(variable, raising=False)
-    _reset_registries()
     _stop_followed_fixtures()
     yield
     _stop_followed_fixtures()
-    _reset_registries()

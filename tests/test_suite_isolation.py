@@ -15,15 +15,31 @@ LEAVES_AND_LOOKS = """
 import os
 from pathlib import Path
 
+from station.methods import names
 from station.tui.instruments import running_fixture, start_demo_fixture
-from station.verdicts import kinds, kind_of, register
-from dataclasses import replace
 
 LEFT = {}
+SITE = '''
+from station.methods.repeatability import Repeatability
 
 
-def test_1_leaves_state_behind():
-    register(replace(kind_of("repeatability"), name="left-behind"))
+class LeftBehind(Repeatability):
+    name = "left-behind"
+
+
+METHOD = LeftBehind()
+'''
+
+
+def test_1_leaves_state_behind(tmp_path, monkeypatch):
+    # A site's method, installed on this test's own path (an entry point of a distribution).
+    info = tmp_path / "left_site-1.0.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: left-site\nVersion: 1.0\n")
+    (info / "entry_points.txt").write_text("[station.methods]\nleft = left_site:METHOD\n")
+    (tmp_path / "left_site.py").write_text(SITE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert "left-behind" in names()
     LEFT["url"] = start_demo_fixture(1).url  # never stopped
     LEFT["home"] = os.environ["HOME"]
     config = Path(os.environ["XDG_CONFIG_HOME"]) / "station"
@@ -32,7 +48,7 @@ def test_1_leaves_state_behind():
 
 
 def test_2_sees_none_of_it():
-    assert "left-behind" not in kinds()
+    assert "left-behind" not in names()
     assert running_fixture(LEFT["url"]) is None
     assert os.environ["HOME"] != LEFT["home"]
     for variable in ("XDG_CONFIG_HOME", "XDG_DATA_HOME", "XDG_STATE_HOME", "XDG_CACHE_HOME"):
@@ -46,8 +62,8 @@ def test_2_sees_none_of_it():
 def test_no_state_carries_from_one_test_to_the_next(
     pytester: pytest.Pytester, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """A test that registers a kind, leaves a followed simulator running, writes a remembered
-    set-up and runs under the developer's settings; the next test sees none of it."""
+    """A test that installs a site's method, leaves a followed simulator running, writes a
+    remembered set-up and runs under the developer's settings; the next test sees none of it."""
     monkeypatch.setenv("STATION_SESSIONS", "/srv/sessions")
     monkeypatch.setenv("NO_COLOR", "1")
     monkeypatch.setenv("PYTHONPATH", str(REPO))  # for -p tests.conftest

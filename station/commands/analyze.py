@@ -18,15 +18,17 @@ from station.commands._args import (
     parse_number,
 )
 from station.errors import StationError
-from station.procedures import analysis_kinds
 
 if TYPE_CHECKING:
     from station.analysis.summary import AnalysisConfig
 
 RULE_CHOICES = ("report", "western-electric", "nelson")
-LINEARITY_COLUMNS = ("stroke", "s", "h", "v")
-ACCURACY_COLUMNS = ("placement", "x", "y", "z")
-PENDANT_COLUMNS = ("px", "py", "pz")
+OPTION_FLAGS = {
+    "reference": "--reference",
+    "tolerance": "--tolerance",
+    "process_variation": "--process-variation",
+}
+"""The command line's values a method's analysis may take (its ``options``), by flag."""
 SUBGROUP_LIMIT = 1000
 """The largest subgroup (X̄-S charts beyond 10; a subgroup of thousands is a typo)."""
 
@@ -46,16 +48,21 @@ pendant's px, py, pz) and adds the accuracy per placement and across
 placements. --procedure gauge_check reads one column of repeated readings of a
 reference and gives the Type-1 study (Cg, Cgk, bias and its t-test, resolution
 against --tolerance) with --reference X_M and --tolerance T; --procedure
-joint_troubleshooting reads joint, x, y, z (and optionally lever: the joint's
-axis to the cube) and names the suspect joint; --procedure gain_schedule reads
-q and one column per gain (see also station gains fit). A session file is
-analysed as its procedure declares (its `analysis`) unless --procedure says
-otherwise.
+gauge_linearity reads reference, value (each reading with the size of the
+master it was read on) and gives the AIAG linearity and bias study (bias per
+master with its t-test, its regression on the size, linearity = |slope|·PV with
+--process-variation PV, the average bias, and a verdict, against --tolerance T
+when given); --procedure joint_troubleshooting reads joint, x, y, z (and
+optionally lever: the joint's axis to the cube) and names the suspect joint;
+--procedure gain_schedule reads q and one column per gain (see also station
+gains fit). A session file is analysed as its procedure declares (its
+`analysis`) unless --procedure says otherwise.
 
 exit codes:
   0  analysed
   1  with --fail-if-incapable: a channel is not capable, has no verdict (no
-     limits) or only a provisional one (fewer readings than --min-n)
+     limits) or only a provisional one (fewer readings than --min-n); a study
+     with a verdict of its own (gauge_linearity) is not ACCEPTABLE
   2  bad input: missing or empty file, a cell that is not a number, impossible
      limits
 """
@@ -116,15 +123,22 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--unit", default="", help="unit of the readings, for the report")
     parser.add_argument(
         "--procedure",
-        metavar="KIND",
-        help=f"what FILE holds: {', '.join(analysis_kinds())} (default: the analysis a "
-        "session's procedure declares, else repeatability)",
+        metavar="METHOD",
+        help="the method FILE is judged by, e.g. linearity or gauge_linearity (see above; "
+        "default: the one a session's procedure declares, else repeatability)",
     )
     parser.add_argument(
         "--tolerance",
         metavar="T",
         help="linearity: straightness tolerance, the zone width per stroke (default: the "
-        "session's, from its h/v limits); gauge_check: the tolerance T the gauge will judge",
+        "session's, from its h/v limits); gauge_check, gauge_linearity: the tolerance T the "
+        "gauge will judge",
+    )
+    parser.add_argument(
+        "--process-variation",
+        metavar="PV",
+        help="gauge_linearity: the process variation (6 sigma) the linearity is stated "
+        "against (default: the session's, else the tolerance)",
     )
     parser.add_argument(
         "--reference",
@@ -162,7 +176,7 @@ def load_source(path: Path) -> Any:
     # A FIFO, a device, a folder or a name too long is refused before a byte is read.
     check_regular_file(path, "file of readings")
     if is_session_file(path):
-        from station.verdicts import load_session_source
+        from station.methods import load_session_source
 
         return load_session_source(path)
     from station.session.tables import read_table
@@ -189,7 +203,6 @@ class TableSource:
     excluded_cycles: tuple[int, ...] = ()
     config: AnalysisConfig | None = None
     notes: tuple[str, ...] = ()
-    analysis: str | None = None
 
 
 def table_times(table: Any) -> dict[str, Any] | None:
@@ -200,33 +213,21 @@ def table_times(table: Any) -> dict[str, Any] | None:
     return {name: table.times for name in table.channels}
 
 
-def table_linearity_profiles(table: Any) -> list[Any]:
-    """The strokes of a linearity CSV (columns stroke, s, h, v)."""
-    from station.analysis.strokes import profiles_from_table
-    from station.session.tables import require_columns
+def method_options(method: Any, given: dict[str, float | None]) -> dict[str, float]:
+    """The command line's values the method takes; StationError naming a flag it does not
+    take (and the ones it does)."""
+    from station.methods import methods
 
-    columns = require_columns(table, LINEARITY_COLUMNS, "a linearity table")
-    return profiles_from_table(
-        columns["stroke"], columns["s"], {"h": columns["h"], "v": columns["v"]}
-    )
-
-
-def table_accuracy_inputs(table: Any) -> tuple[Any, dict[str, Any], dict[int, tuple[float, ...]]]:
-    """Placements, errors x, y, z and pendant coordinates of a relative-accuracy CSV."""
-    from station.session.tables import require_columns
-
-    if table.placements is not None and "placement" not in {n.lower() for n in table.channels}:
-        # A tidy table keeps the placement beside each cycle, not as a channel.
-        table = replace(table, channels={**table.channels, "placement": table.placements})
-    columns = require_columns(table, ACCURACY_COLUMNS, "a relative-accuracy table")
-    pendant: dict[int, tuple[float, ...]] = {}
-    lowered = {name.lower() for name in table.channels}
-    if set(PENDANT_COLUMNS) <= lowered:
-        coordinates = require_columns(table, PENDANT_COLUMNS, "the pendant")
-        for row, number in enumerate(columns["placement"]):
-            pendant.setdefault(int(number), tuple(coordinates[c][row] for c in PENDANT_COLUMNS))
-    errors = {axis: columns[axis] for axis in ("x", "y", "z")}
-    return columns["placement"], errors, pendant
+    for name, value in given.items():
+        if value is not None and name not in method.options:
+            takers = [m.name for m in methods().values() if name in m.options]
+            takes = [OPTION_FLAGS[o] for o in method.options if o in OPTION_FLAGS]
+            raise StationError(
+                f"{OPTION_FLAGS[name]} is not an option of --procedure {method.name}"
+                + (f" (it takes {', '.join(takes)})" if takes else "")
+                + (f"; it belongs to --procedure {' or '.join(takers)}." if takers else ".")
+            )
+    return {name: value for name, value in given.items() if value is not None}
 
 
 def run(args: argparse.Namespace) -> int:
@@ -280,48 +281,48 @@ def run(args: argparse.Namespace) -> int:
     freeze_after = bounded_int(args.freeze_after, "--freeze-after", 2, SUBGROUP_LIMIT)
     if freeze_after is not None:
         config = replace(config, freeze_after=freeze_after)
-    procedure = args.procedure or source.analysis or "repeatability"
+    from station.methods import (
+        MethodInputs,
+        judge,
+        method_of,
+        names,
+        report_session,
+        session_method,
+    )
+
+    if isinstance(source, TableSource):
+        method = method_of(args.procedure or names()[0])
+    else:
+        method = method_of(args.procedure or session_method(source.session))
     tolerance = parse_number(args.tolerance, "--tolerance")
     if tolerance is not None and not tolerance > 0:
         raise StationError(f"--tolerance {args.tolerance!r} must be greater than 0.")
-    reference = parse_number(args.reference, "--reference")
-    options: dict[str, Any] = {}
-    if procedure == "gauge_check":
-        # The gauge check's own values (a session's typed ones unless given here).
-        options = {
-            name: value
-            for name, value in (("reference", reference), ("tolerance", tolerance))
-            if value is not None
-        }
-        tolerance = None
-    elif reference is not None:
-        raise StationError("--reference is the reference size of --procedure gauge_check.")
-    elif tolerance is not None and procedure != "linearity":
+    variation = parse_number(args.process_variation, "--process-variation")
+    if variation is not None and not variation > 0:
         raise StationError(
-            "--tolerance is the straightness tolerance of --procedure linearity (or the "
-            "tolerance T of --procedure gauge_check)."
+            f"--process-variation {args.process_variation!r} must be greater than 0."
         )
-    from station.verdicts import KindInputs, judge, report_session
-
+    options = method_options(
+        method,
+        {
+            "reference": parse_number(args.reference, "--reference"),
+            "tolerance": tolerance,
+            "process_variation": variation,
+        },
+    )
     if isinstance(source, TableSource):
-        table = source.table
-        inputs = KindInputs(
+        inputs = MethodInputs(
             config=config,
             channels=channels,
             cycles=source.cycles,
             excluded_cycles=source.excluded_cycles,
-            profiles=lambda: table_linearity_profiles(table),
-            accuracy_inputs=lambda: table_accuracy_inputs(table),
-            tolerance=tolerance,
+            times=table_times(source.table),
             options=options,
-            table=table,
-            times=table_times(table),
+            table=source.table,
         )
-        report = judge(procedure, inputs, name=path.name)
+        report = judge(method, inputs, name=path.name)
     else:
-        report = report_session(
-            source, config=config, kind=procedure, tolerance=tolerance, options=options
-        )
+        report = report_session(source, config=config, method=method.name, options=options)
     if report.empty:
         raise StationError(f"{path}: the session has no accepted readings to analyse yet.")
     analysis = report.analysis
@@ -336,15 +337,16 @@ def run(args: argparse.Namespace) -> int:
     if args.fail_if_incapable:
         # A channel without a verdict (no limits, too few readings) fails too: a script that
         # asks for the verdict must not pass on data that was never judged.
-        failed = (
-            [
-                f"{name} ({_failure(c)})"
-                for name, c in analysis.channels.items()
-                if c.capability.capable is not True or (c.verdict and c.verdict.provisional)
-            ]
-            if analysis is not None
-            else [f"{procedure} (no verdict: it judges no readings)"]
-        )
+        failed = [
+            f"{name} ({_failure(c)})"
+            for name, c in (analysis.channels.items() if analysis is not None else ())
+            if c.capability.capable is not True or (c.verdict and c.verdict.provisional)
+        ]
+        own = report.verdict
+        if own is not None and own.accepted is not True:
+            failed.append(f"{method.name} ({own.word})")
+        elif analysis is None and own is None:
+            failed.append(f"{method.name} (no verdict: it judges no readings)")
         if failed:
             print(f"station: failed the capability check: {', '.join(failed)}", file=sys.stderr)
             return 1

@@ -16,7 +16,9 @@ pace, rejecting one cycle with a reason) and stops on the summary.
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
+from typing import Any
 
 DEMO_CYCLE_PERIOD = 2.0
 """Seconds per round trip of the demo's repeatability robot: the rhythm of a playback loop."""
@@ -32,7 +34,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description="Runs the TUI against a simulated robot on a pseudo-terminal: set-up, "
         "checklist, captures, verdict. repeatability: a fixture with three dial indicators, "
         "30 cycles; relative_accuracy: two fixtures and a teach pendant, a few placements; "
-        "linearity: a parallel bar with indicators h, v and a linear scale s, 30 strokes.",
+        "linearity: a parallel bar with indicators h, v and a linear scale s, 30 strokes; "
+        "gauge_check: an indicator over a surface plate and a gauge block; gauge_linearity: "
+        "the same indicator and five gauge blocks over its travel. A gauge study the demo runs "
+        "is filed in the demo folder's own gauge register.",
     )
     parser.add_argument(
         "--autopilot",
@@ -43,7 +48,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--procedure",
         default="repeatability",
         metavar="ID",
-        help="procedure id: repeatability, relative_accuracy or linearity (default: %(default)s)",
+        help="procedure id: repeatability, relative_accuracy, linearity, gauge_check or "
+        "gauge_linearity each have a simulated set-up; another runs against its method's, or "
+        "the repeatability fixture (default: %(default)s)",
     )
     parser.add_argument(
         "--count",
@@ -78,6 +85,7 @@ def run(args: argparse.Namespace) -> int:
     """Start the simulated fixture, then the TUI on a demo sessions folder."""
     from station.commands.tui import run_app
     from station.errors import StationError
+    from station.session.gauge_register import REGISTER_ENV
     from station.session.store import sessions_folder
     from station.tui.app import DemoPort, StationApp, StationConfig
     from station.tui.instruments import DemoLab
@@ -86,13 +94,16 @@ def run(args: argparse.Namespace) -> int:
         raise StationError(f"--pace must be 0 or more seconds, not {args.pace}")
     if args.count is not None and args.count < 1:
         raise StationError(f"--count must be 1 or more, not {args.count}")
-    _check_demo_choice(args)
+    procedure = _demo_choice(args)
     folder, reason = sessions_folder(args.sessions)
     if not args.cycle_period > 0:
         raise StationError(f"--cycle-period must be more than 0 seconds, not {args.cycle_period}")
+    # A gauge study the demo runs files itself in the demo's own gauge register, never in the
+    # station's (a simulated indicator is no gauge of the site's).
+    os.environ[REGISTER_ENV] = str(folder / "demo" / "gauges.json")
     lab = DemoLab(args.seed, cycle_period=args.cycle_period)
     try:
-        fixture = lab.fixture(args.procedure)
+        fixture = lab.fixture(procedure.analysis)
         config = StationConfig(
             sessions_dir=folder / "demo",
             # The path above already names the folder: say only why it is this one.
@@ -116,9 +127,10 @@ def run(args: argparse.Namespace) -> int:
         lab.stop()
 
 
-def _check_demo_choice(args: argparse.Namespace) -> None:
-    """A procedure that does not exist, or a --count below what its set-up accepts, is refused
-    here with a sentence (the TUI would open on it and wait forever)."""
+def _demo_choice(args: argparse.Namespace) -> Any:
+    """The procedure asked for; one that does not exist, or a --count below what its set-up
+    accepts, is refused here with a sentence (the TUI would open on it and wait forever)."""
+    import station.methods  # noqa: F401 - procedure files name the methods
     from station.errors import StationError
     from station.procedures import discover_procedures
     from station.tui.screens.setup_form import DEMO_TRIAL_MINIMUM, count_field
@@ -128,8 +140,9 @@ def _check_demo_choice(args: argparse.Namespace) -> None:
         raise StationError(
             f"no procedure {args.procedure!r}; choose one of {', '.join(catalog.ids())}"
         )
+    procedure = catalog.get(args.procedure)
     if args.count is not None:
-        count = count_field(catalog.get(args.procedure))
+        count = count_field(procedure)
         # A demo may be a short trial run (the set-up says the report's range).
         minimum = min(count.minimum, DEMO_TRIAL_MINIMUM)
         if args.count < minimum:
@@ -137,3 +150,4 @@ def _check_demo_choice(args: argparse.Namespace) -> None:
                 f"--count {args.count} is too few for {args.procedure}: "
                 f"give at least {minimum} {count.noun}"
             )
+    return procedure

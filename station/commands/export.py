@@ -18,9 +18,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "Write a session's readings as CSV. Tidy (repeatability's default): cycle, channel, "
             "value, unit, status (ok or 'rejected: <reason>'), time, then raw value, zero offset "
             "and placement; rejected cycles stay in the export, marked. Wide (the default for "
-            "linearity and relative accuracy): the table `station analyze --procedure KIND` "
-            "reads, accepted readings only, rejected cycles named in '#' lines. `station "
-            "analyze` reads both layouts. The session file is opened read-only."
+            "linearity, relative accuracy and the gauge linearity study): the table `station "
+            "analyze --procedure NAME` reads, accepted readings only, rejected cycles named in "
+            "'#' lines. `station analyze` reads both layouts. The session file is opened "
+            "read-only."
         ),
     )
     parser.add_argument("file", metavar="FILE", help="the session file (.jsonl)")
@@ -35,9 +36,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         choices=("auto", "tidy", "wide"),
         default="auto",
         help="tidy: one row per cycle and channel; wide: the table `station analyze` reads for "
-        "the session's procedure (linearity: stroke,s,h,v; relative accuracy: "
-        "cycle,placement,x,y,z,px,py,pz; else cycle,x,y,z of the accepted cycles); auto "
-        "(default): wide for linearity and relative accuracy, tidy otherwise",
+        "the session's method (linearity: stroke,s,h,v; relative accuracy: "
+        "cycle,placement,x,y,z,px,py,pz; gauge linearity: cycle,reference,value; else "
+        "cycle,t,x,y,z of the accepted cycles); auto (default): the method's own choice (wide "
+        "for linearity, relative accuracy and gauge linearity, tidy otherwise)",
     )
     parser.add_argument("--force", action="store_true", help="overwrite OUT when it exists")
     parser.set_defaults(func=run)
@@ -45,21 +47,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Export; StationError for a missing session or an existing OUT without --force."""
-    from station.record.export import export_table
+    from station.record.export import default_layout, export_table
     from station.session.durable import replace_durably
     from station.session.model import load_session
-    from station.verdicts import kind_of, session_analysis
 
     session = load_session(args.file, recover=False)
     if session.torn is not None:
         print(f"station: note: {session.torn.message}", file=sys.stderr)
-    kind = session_analysis(session)
-    layout = args.layout
-    if layout == "auto":
-        layout = kind_of(kind).export_layout
+    layout = default_layout(session) if args.layout == "auto" else args.layout
 
     if not args.output:
-        export_table(session, sys.stdout, layout, kind)
+        export_table(session, sys.stdout, layout)
         return 0
     out = Path(args.output)
     try:
@@ -67,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
         # Never written through a link, and never over the session file itself.
         rows = replace_durably(
             out,
-            lambda handle: export_table(session, handle, layout, kind),
+            lambda handle: export_table(session, handle, layout),
             overwrite=args.force,
             not_over=Path(args.file),
         )

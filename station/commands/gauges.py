@@ -11,13 +11,15 @@ from station.errors import StationError
 
 DESCRIPTION = """\
 The gauge register: per gauge id or serial, the Type-1 gauge checks recorded
-(date, result, Cg, Cgk, bias) and the calibration due date. It lives in
+(date, result, Cg, Cgk, bias), the other studies of the gauge (a linearity and
+bias study over its travel) and the calibration due date. It lives in
 $XDG_DATA_HOME/station/gauges.json (~/.local/share/station/gauges.json), or
 the file STATION_GAUGES names.
 
   station gauges list [--json]           every gauge and its status today
   station gauges status ID... [--json]   passed / failed / overdue / none
-  station gauges record SESSION.jsonl    file a finished gauge_check session
+  station gauges record SESSION.jsonl    file a finished gauge_check or
+                                         gauge_linearity session
 
 A check is overdue when the calibration due date has passed or the check is
 older than 183 days (the report's "every four to six months").
@@ -43,8 +45,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     status.add_argument("gauges", nargs="+", metavar="ID", help="gauge id or serial")
     status.add_argument("--json", action="store_true", help="print one JSON document")
     status.set_defaults(func=run_status)
-    record = actions.add_parser("record", help="file a finished gauge_check session")
-    record.add_argument("session", metavar="SESSION.jsonl", help="a gauge_check session file")
+    record = actions.add_parser(
+        "record", help="file a finished gauge study (gauge_check, gauge_linearity) session"
+    )
+    record.add_argument(
+        "session", metavar="SESSION.jsonl", help="a gauge_check or gauge_linearity session file"
+    )
     record.set_defaults(func=run_record)
     for action in (listing, status, record):
         action.add_argument("--register", metavar="FILE", help="another register file")
@@ -56,16 +62,23 @@ def _register(args: argparse.Namespace) -> Path:
     return Path(args.register) if args.register else register_path()
 
 
-def _print(statuses: list, as_json: bool, path: Path) -> None:
+def _print(statuses: list, as_json: bool, path: Path, register: dict) -> None:
+    from station.session.gauge_register import latest_studies, study_sentence
+
+    records = register.get("gauges") or {}
     if as_json:
-        document = {"register": str(path), "gauges": [s.as_json() for s in statuses]}
-        print(json.dumps(document, indent=2))
+        gauges = [
+            {**s.as_json(), "studies": latest_studies(records.get(s.gauge))} for s in statuses
+        ]
+        print(json.dumps({"register": str(path), "gauges": gauges}, indent=2))
         return
     print(f"gauge register: {path}")
     if not statuses:
         print("no gauges recorded yet: run the gauge_check procedure, then `station gauges record`")
     for status in statuses:
         print(status.sentence())
+        for method, entry in latest_studies(records.get(status.gauge)).items():
+            print(f"  {study_sentence(method, entry)}")
 
 
 def run_list(args: argparse.Namespace) -> int:
@@ -73,7 +86,8 @@ def run_list(args: argparse.Namespace) -> int:
     from station.session.gauge_register import load_register, register_rows
 
     path = _register(args)
-    _print(register_rows(load_register(path), dt.date.today()), args.json, path)
+    register = load_register(path)
+    _print(register_rows(register, dt.date.today()), args.json, path, register)
     return 0
 
 
@@ -84,30 +98,24 @@ def run_status(args: argparse.Namespace) -> int:
     path = _register(args)
     register = load_register(path)
     statuses = [gauge_status(register, gauge, dt.date.today()) for gauge in args.gauges]
-    _print(statuses, args.json, path)
+    _print(statuses, args.json, path, register)
     return 0 if all_covered({s.gauge: s for s in statuses}) else 1
 
 
 def run_record(args: argparse.Namespace) -> int:
-    """Analyse a gauge_check session and file its study under the gauge id typed in it."""
-    from station.session.method_reports import gauge_check_from_session, record_gauge_check
+    """File a finished gauge study session (its method says how) in the gauge register."""
+    from station.methods import method_of, session_method
     from station.session.model import load_session
-    from station.verdicts import session_analysis
 
     session = load_session(Path(args.session), recover=False)
-    kind = session_analysis(session)
-    if kind != "gauge_check":
+    method = method_of(session_method(session))
+    if not method.files_in_register:
         raise StationError(
-            f"{args.session} is a {kind} session, not a gauge check; record gauge_check sessions."
+            f"{args.session} is a {method.name} session, which files nothing in the gauge "
+            "register; record a gauge study (gauge_check, gauge_linearity) session."
         )
     if not session.finished:
         raise StationError(f"{args.session} is not finished; finish it before recording it.")
-    study = gauge_check_from_session(session)
-    path = _register(args)
-    entry = record_gauge_check(session, study, register=path)
-    print(
-        f"recorded in {path}: gauge check {entry['result']} on {entry['date']} "
-        f"(Cg {study.cg if study.cg is None else round(study.cg, 2)}, "
-        f"Cgk {study.cgk if study.cgk is None else round(study.cgk, 2)})"
-    )
+    for sentence in method.file_in_register(Path(args.session), _register(args)):
+        print(sentence)
     return 0

@@ -29,6 +29,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Print one line per procedure, then the notes; 1 when a file failed to load."""
+    import station.methods  # noqa: F401 - procedure files name the methods
     from station.procedures import discover_procedures
 
     catalog = discover_procedures(args.procedures)

@@ -54,10 +54,13 @@ others):
                Printed on stderr as "joint J: ..." when the next joint's turn
                comes, with its lever arm. Each joint's turn is a rest at the
                taught position (the zero), then its returns.
-  gauge-bench  the gauge check (Type-1 study): one indicator x in inches over
-               a surface plate (zeroing reads the plate), a gauge block of
-               --reference size re-seated for every reading, read with the
-               indicator's --bias and --noise (default 0.00003). The first
+  gauge-bench  the gauge studies: one indicator x in inches over a surface
+               plate (zeroing reads the plate), a gauge block of --reference
+               size re-seated for every reading (the gauge check), or several
+               (--reference 0.1,0.3,0.5,0.7,0.9: the linearity and bias study)
+               in turn, --readings-per-block seatings each (12). It reads a
+               block of size r as r + bias + slope*r: --bias, and --slope its
+               linearity error (0), with --noise (default 0.00003). The first
                rest is the plate (the zero), every later one a seating.
 
 The models follow the robot's state, not the readings: at each rest every
@@ -163,8 +166,22 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     joints.add_argument(
         "--cycles-per-joint", default="25", metavar="N", help="returns per joint (25)"
     )
-    bench = parser.add_argument_group("gauge-bench model (gauge check)")
-    bench.add_argument("--reference", default="0.1", metavar="V", help="gauge block size (0.1)")
+    bench = parser.add_argument_group("gauge-bench model (gauge check, linearity study)")
+    bench.add_argument(
+        "--reference",
+        default="0.1",
+        metavar="V[,V...]",
+        help="gauge block size (0.1), or the sizes of several blocks read in turn",
+    )
+    bench.add_argument(
+        "--slope",
+        default="0",
+        metavar="S",
+        help="the indicator's linearity error: its bias grows by S per unit of size (0)",
+    )
+    bench.add_argument(
+        "--readings-per-block", default="12", metavar="N", help="seatings of each block (12)"
+    )
     gauge = parser.add_argument_group("gauge")
     gauge.add_argument(
         "--resolution", help="gauge resolution (0.001; two-fixture and bar 0.0001 in)"
@@ -294,11 +311,13 @@ def _procedure_model(args: argparse.Namespace, protocol, seed: int):
 
         bias = per_channel(args.bias, "--bias", ["x"])["x"]
         noise = per_channel(args.noise, "--noise", ["x"])["x"]
-        reference = _float(args.reference, "--reference")
+        references = [_float(part, "--reference") for part in args.reference.split(",")]
         return GaugeBenchModel(
-            reference,
+            references,
             bias=bias,
+            slope=_float(args.slope, "--slope", -1.0, 1.0),
             noise=noise,
+            readings=positive_number(args.readings_per_block, "--readings-per-block", int),
             gauge=GaugeSpec(resolution, -0.5, 1.0, "in", gauge_noise),
         )
     if args.model == "joints":

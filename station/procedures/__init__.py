@@ -14,10 +14,12 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
     channels = ["x", "y", "z"]
     unit = "in"                     # "in" or "mm"
     resolution = 0.0001             # the gauge's resolution in `unit`
-    analysis = "repeatability"      # optional: repeatability, relative_accuracy, linearity,
-                                    # gauge_check, joint_troubleshooting or gain_schedule;
+    analysis = "repeatability"      # optional: the method that judges its sessions (see
+                                    # station.methods: repeatability, relative_accuracy,
+                                    # linearity, gauge_check, gauge_linearity,
+                                    # joint_troubleshooting, gain_schedule or a site's own);
                                     # default by the steps: a stroke step -> linearity, a repeat
-                                    # block -> relative_accuracy, else repeatability
+                                    # block over x, y, z -> relative_accuracy, else repeatability
 
     [cycles]                        # optional; default min 25, target 30 (the report's 25 to 30)
     min = 25
@@ -85,9 +87,9 @@ from station.procedures.kinds import (
     StepSchema,
     analysis_kinds,
     analysis_needs,
-    register_analysis_needs,
-    register_step_schema,
     step_kinds,
+    step_schema,
+    use_methods,
 )
 from station.procedures.loading import load_procedure, parse_procedure
 from station.procedures.model import (
@@ -124,7 +126,7 @@ __all__ = [
     "load_procedure",
     "parse_procedure",
     "procedure_dirs_from_env",
-    "register_analysis_needs",
-    "register_step_schema",
     "step_kinds",
+    "step_schema",
+    "use_methods",
 ]

@@ -1,12 +1,18 @@
-"""The registries a procedure file is validated against: what each step kind may hold (its
-:class:`StepSchema`) and what each analysis kind needs of a procedure (:class:`AnalysisNeeds`).
-The step-handler and analysis-kind registries add to them, so a kind the loader has never seen
-the code of is validated all the same."""
+"""What a procedure file is validated against: what each step kind may hold (its
+:class:`StepSchema`) and what each calibration method needs of a procedure
+(:class:`AnalysisNeeds`).
+
+The step kinds' schemas are data here (the engine's handlers register theirs too, so a site's
+step kind is validated all the same); the methods live above this package
+(:mod:`station.methods`), which tells the loader their needs through :func:`use_methods`.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
+from station.extensions import STEP_KINDS, site_extensions
 from station.procedures.model import ID_PATTERN
 
 
@@ -29,8 +35,6 @@ class StepSchema:
     """A block of inner ``steps`` repeated ``target`` times (no nesting)."""
     zero_window: bool = False
     """``readings``, ``settle`` and ``still``: a zero taken as the mean of several readings."""
-    implies_analysis: str | None = None
-    """The analysis kind a procedure holding this step defaults to."""
 
     @property
     def allowed(self) -> tuple[str, ...]:
@@ -52,14 +56,14 @@ _STEP_SCHEMAS: dict[str, StepSchema] = {
     "zero": StepSchema(channels=True, zero_window=True),
     "capture": StepSchema(channels=True),
     "cycles": StepSchema(channels=True, counts=True),
-    "stroke": StepSchema(channels=True, counts=True, direction=True, implies_analysis="linearity"),
-    "repeat": StepSchema(block=True, implies_analysis="relative_accuracy"),
+    "stroke": StepSchema(channels=True, counts=True, direction=True),
+    "repeat": StepSchema(block=True),
 }
 
 
 @dataclass(frozen=True)
 class AnalysisNeeds:
-    """What a procedure must hold for an analysis kind: a step of a kind with ``facet`` (e.g.
+    """What a procedure must hold for a method: a step of a kind with ``facet`` (e.g.
     ``direction`` for streamed strokes, ``block`` for placements), inside a repeat block when
     ``facet_in_block``; these ``channels``; and input steps with the number fields ``numbers``
     plus ``more_numbers`` others (a gain schedule's position ``q`` and one field per gain).
@@ -76,67 +80,65 @@ class AnalysisNeeds:
     """Whether the kind's verdict judges the session's spec limits (a gauge check judges
     against its reference and tolerance, a gain schedule judges nothing): a set-up screen
     asks for limits only when it does."""
+    implied: bool = False
+    """A procedure that declares no ``analysis`` is judged by the first method (in the
+    catalog's order) whose needs are ``implied`` and that its steps and channels meet (a
+    stroke step: linearity; a repeat block over x, y, z: relative accuracy)."""
 
 
-_ANALYSES: dict[str, AnalysisNeeds] = {
-    "repeatability": AnalysisNeeds(),
-    "relative_accuracy": AnalysisNeeds(
-        facet="block", facet_words="a repeat block (one per placement)", channels=("x", "y", "z")
-    ),
-    "linearity": AnalysisNeeds(facet="direction", facet_words="a stroke step (streamed strokes)"),
-    # The rest of the report's method (station.method_kinds registers them with these needs;
-    # they are known here too so that a file declaring them loads without the registry).
-    "gauge_check": AnalysisNeeds(
-        facet="counts",
-        facet_words="a cycles step (the repeated readings)",
-        numbers=("reference", "tolerance"),
-        numbers_words="an input step with number fields 'reference' and 'tolerance'",
-        limits=False,
-    ),
-    "joint_troubleshooting": AnalysisNeeds(
-        facet="counts",
-        facet_in_block=True,
-        facet_words="a repeat block (one per joint) holding a cycles step",
-        channels=("x", "y", "z"),
-    ),
-    "gain_schedule": AnalysisNeeds(
-        numbers=("q",),
-        more_numbers=1,
-        numbers_words="an input step with a number field 'q' (the position) and one number "
-        "field per gain",
-        limits=False,
-    ),
-}
+_NEEDS: Callable[[str], AnalysisNeeds | None] | None = None
+_NAMES: Callable[[], tuple[str, ...]] | None = None
 
 
-def register_step_schema(kind: str, schema: StepSchema) -> None:
-    """Let procedure files use step kind ``kind`` with ``schema`` (called by the step-handler
-    registry when a handler is registered)."""
-    if not ID_PATTERN.match(kind):
-        raise ValueError(f"a step kind is a plain name, not {kind!r}")
-    _STEP_SCHEMAS[kind] = schema
+def use_methods(
+    needs: Callable[[str], AnalysisNeeds | None], names: Callable[[], tuple[str, ...]]
+) -> None:
+    """Let procedure files declare the methods ``names()`` lists, each holding what
+    ``needs(name)`` says (None: no such method). Called once by :mod:`station.methods`, which
+    sits above this package: the methods are known here only through it."""
+    global _NEEDS, _NAMES
+    _NEEDS, _NAMES = needs, names
 
 
-def register_analysis_needs(kind: str, needs: AnalysisNeeds) -> None:
-    """Let procedure files declare ``analysis = kind`` (called by the analysis-kind registry)."""
-    _ANALYSES[kind] = needs
+def _methods() -> tuple[Callable[[str], AnalysisNeeds | None], Callable[[], tuple[str, ...]]]:
+    if _NEEDS is None or _NAMES is None:
+        # A programming error, not an operator's: whatever loads procedure files imports
+        # station.methods first (every front end and the engine do).
+        raise RuntimeError("no methods are known: import station.methods before loading procedures")
+    return _NEEDS, _NAMES
 
 
 def step_schema(kind: str) -> StepSchema:
     """What a step of kind ``kind`` may hold (KeyError for an unknown kind)."""
-    return _STEP_SCHEMAS[kind]
+    if kind in _STEP_SCHEMAS:
+        return _STEP_SCHEMAS[kind]
+    return _site_step_schemas()[kind]
 
 
 def step_kinds() -> tuple[str, ...]:
-    """The step kinds a procedure file may use."""
-    return tuple(_STEP_SCHEMAS)
+    """The step kinds a procedure file may use: the built-in ones, then a site's."""
+    return tuple(dict.fromkeys([*_STEP_SCHEMAS, *_site_step_schemas()]))
+
+
+def _site_step_schemas() -> dict[str, StepSchema]:
+    """The schemas of the step kinds a site's installed packages offer (their handlers'
+    ``kind`` and ``schema``; the handlers themselves are the engine's business)."""
+    found: dict[str, StepSchema] = {}
+    for handler in site_extensions(STEP_KINDS).loaded:
+        kind, schema = getattr(handler, "kind", None), getattr(handler, "schema", None)
+        if isinstance(kind, str) and ID_PATTERN.match(kind) and isinstance(schema, StepSchema):
+            found.setdefault(kind, schema)
+    return found
 
 
 def analysis_needs(kind: str) -> AnalysisNeeds:
     """What a procedure declaring ``analysis = kind`` must hold (KeyError for an unknown kind)."""
-    return _ANALYSES[kind]
+    found = _methods()[0](kind)
+    if found is None:
+        raise KeyError(kind)
+    return found
 
 
 def analysis_kinds() -> tuple[str, ...]:
-    """The analysis kinds a procedure file may declare."""
-    return tuple(_ANALYSES)
+    """The methods a procedure file may declare (``analysis = NAME``), the default first."""
+    return _methods()[1]()

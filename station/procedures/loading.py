@@ -227,20 +227,24 @@ def _free_travel(
 def _analysis_kind(
     check: Checker, declared: Any, steps: tuple[Step, ...], channels: tuple[str, ...]
 ) -> AnalysisKind:
-    """The declared analysis kind, checked against what the steps record; else the default
+    """The declared method, checked against what the steps record; else the default
     the steps imply (a stroke step: linearity; a repeat block: relative accuracy)."""
     every_step = [inner for step in steps for inner in (step, *step.steps)]
     schemas = [step_schema(step.kind) for step in every_step]
     if declared is None:
-        # The first kind the steps imply whose channels the procedure has (a repeat block over
-        # x alone is judged as repeatability).
-        implied = [
-            schema.implies_analysis
-            for schema in schemas
-            if schema.implies_analysis
-            and set(analysis_needs(schema.implies_analysis).channels) <= set(channels)
-        ]
-        return implied[0] if implied else "repeatability"
+        # The first method whose needs its steps and channels meet (a repeat block over x alone
+        # is judged as the default method is); else the default, first in the catalog.
+        known = analysis_kinds()
+        for name in known:
+            needs = analysis_needs(name)
+            if (
+                needs.implied
+                and needs.facet
+                and any(getattr(schema, needs.facet) for schema in schemas)
+                and set(needs.channels) <= set(channels)
+            ):
+                return name
+        return known[0]
     if declared not in analysis_kinds():
         known = ", ".join(analysis_kinds())
         raise check.fail("", f"'analysis' must be one of {known}, not {declared!r}")

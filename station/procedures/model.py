@@ -16,7 +16,7 @@ StepKind = str
 """A step kind: one of :func:`step_kinds` (the built-ins, and any a handler registered)."""
 UNITS: tuple[str, ...] = ("in", "mm")
 AnalysisKind = str
-"""An analysis kind: one of :func:`analysis_kinds`."""
+"""A method's name (what ``analysis =`` names): one of :func:`analysis_kinds`."""
 
 DEFAULT_CYCLES_MIN = 25
 #: The assignable causes an alarm is acknowledged with when the procedure names none.

@@ -1,10 +1,12 @@
 """The report's charts as SVG text (matplotlib's SVG backend, no display, no global state).
 
-Each chart is one ``Figure`` drawn by ``FigureCanvasSVG``: the histogram of each channel against
-its limits, the control chart with its limits and the alarms marked, the 3-D offsets of x, y, z,
-the linearity profiles (least-squares line and minimum zone of the widest stroke), and the
-readings over time with their trend (drift). Text is kept as SVG text (searchable, small), and
-maths parsing is off: a channel name is shown as typed.
+Each chart is one ``Figure`` drawn by ``FigureCanvasSVG``: the method's own charts (linearity's
+profiles along the bar, a gauge study's bias against the size: :meth:`Method.charts
+<station.methods.contract.Method.charts>`, drawn with this module's figure and colours), then the
+histogram of each judged channel against its limits, the control chart with its limits and the
+alarms marked, the 3-D offsets of x, y, z, and the readings over time with their trend (drift)
+where the method's readings are cycles in time order. Text is kept as SVG text (searchable,
+small), and maths parsing is off: a channel name is shown as typed.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from station.methods import Judgement
 from station.record.content import parse_time
 from station.record.source import AnalysedSession
 
@@ -146,41 +149,6 @@ def offsets_chart(analysis: Any, unit: str) -> Any:
     return figure
 
 
-def linearity_chart(channel: str, analysed: AnalysedSession, unit: str) -> Any:
-    """Every stroke's deviation along the bar (grey), the widest stroke in colour with its
-    least-squares line and its minimum zone (two parallel lines)."""
-    result = analysed.report.result  # type: ignore[union-attr]
-    profiles = {p.number: p for p in analysed.profiles}
-    figure = _figure()
-    axes = figure.add_subplot()
-    for profile in analysed.profiles:
-        axes.plot(profile.s, profile.channels[channel], color="lightgrey", linewidth=0.8)
-    widest = max(result.strokes, key=lambda r: r.straightness[channel].mz, default=None)
-    if widest is not None and widest.number in profiles:
-        profile = profiles[widest.number]
-        s = np.asarray(profile.s, dtype=float)
-        d = np.asarray(profile.channels[channel], dtype=float)
-        straight = widest.straightness[channel]
-        axes.plot(s, d, color=POINT_COLOUR, linewidth=1.2, label=f"stroke {widest.number}")
-        a, b = straight.ls_line
-        axes.plot(s, a + b * s, color=CENTRE_COLOUR, label=f"LS line (LS {straight.ls:.4g})")
-        a, b = straight.mz_line
-        for offset in (-straight.mz / 2, straight.mz / 2):
-            axes.plot(
-                s,
-                a + b * s + offset,
-                color=LIMIT_COLOUR,
-                linestyle="--",
-                label=f"minimum zone (MZ {straight.mz:.4g})" if offset > 0 else None,
-            )
-    suffix = f" ({unit})" if unit else ""
-    axes.set_title(f"Straightness profiles of {channel} along the bar")
-    axes.set_xlabel("position s" + suffix)
-    axes.set_ylabel(f"deviation {channel}{suffix}")
-    axes.legend(loc="upper right", fontsize=7)
-    return figure
-
-
 def drift_chart(analysed: AnalysedSession, unit: str) -> Any | None:
     """Each channel's accepted readings against the time since the first (seconds, minutes or
     hours, as the session's length suits), with its least-squares trend; None with fewer than
@@ -227,19 +195,36 @@ def drift_chart(analysed: AnalysedSession, unit: str) -> Any | None:
     return figure
 
 
+@dataclass(frozen=True)
+class _Kit:
+    """What a method draws its own charts with (:class:`station.methods.contract.ChartKit`):
+    this module's figure and colours."""
+
+    point: str = POINT_COLOUR
+    centre: str = CENTRE_COLOUR
+    limit: str = LIMIT_COLOUR
+    alarm: str = ALARM_COLOUR
+
+    def figure(self, width: float = 7.0, height: float = 3.2) -> Any:
+        """A new figure of that size (inches)."""
+        return _figure(width, height)
+
+    def label(self, text: object) -> str:
+        """Text from outside as a chart shows it."""
+        return str(text)
+
+
 def _figures(analysed: AnalysedSession) -> Iterator[tuple[str, str, Any]]:
     report = analysed.report
-    if report is None or report.analysis is None:
+    if report is None:
         return
+    if report.inputs is not None:
+        judgement = Judgement(report.analysis, report.result, report.sections, report.verdict)
+        yield from report.method.charts(report.inputs, judgement, _Kit())
     analysis = report.analysis
+    if analysis is None:
+        return
     unit = analysis.config.unit
-    if analysed.kind == "linearity":
-        for channel in report.result.channels:
-            yield (
-                f"profile-{channel}",
-                f"Linearity profiles of {channel}",
-                linearity_chart(channel, analysed, unit),
-            )
     for key, channel in analysis.channels.items():
         yield (
             f"histogram-{key}",
@@ -254,7 +239,7 @@ def _figures(analysed: AnalysedSession) -> Iterator[tuple[str, str, Any]]:
             )
     if analysis.spatial is not None:
         yield "offsets-3d", "3-D offsets", offsets_chart(analysis, unit)
-    if analysed.kind != "linearity":
+    if report.method.drift_chart:
         drift = drift_chart(analysed, unit)
         if drift is not None:
             yield "drift", "Readings over time (drift)", drift

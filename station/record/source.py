@@ -2,8 +2,8 @@
 
 Reports, history, comparison and baselines read a session's analysis only through
 :func:`analyse_session`. It calls the domain function that turns a session into its analysis and
-JSON document through the analysis-kind registry (:func:`station.verdicts.report_session`); if
-that changes, only this function changes.
+JSON document by its method (:func:`station.methods.report_session`); if that changes, only this
+function changes.
 """
 
 from __future__ import annotations
@@ -13,13 +13,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from station.errors import StationError
+from station.methods import report_session, session_method, session_source
 from station.session.model import load_session
-from station.verdicts import report_session, session_source, session_stroke_profiles
 
 if TYPE_CHECKING:
-    from station.analysis.strokes import StrokeProfile
+    from station.methods import SessionReport
     from station.session.model import Session
-    from station.verdicts import SessionReport
 
 
 @dataclass(frozen=True)
@@ -28,9 +27,8 @@ class AnalysedSession:
 
     ``report`` is the domain's analysis and report blocks, ``document`` its JSON document
     (``station analyze --json``); both None when the session has nothing to analyse yet, with
-    the sentence in ``problem``. ``kind`` is the analysis kind (repeatability, linearity,
-    relative_accuracy). ``profiles`` are the streamed strokes of a linearity session (for its
-    charts), else empty.
+    the sentence in ``problem``. ``kind`` is the name of its method (repeatability,
+    linearity, ...).
     """
 
     path: Path
@@ -39,7 +37,6 @@ class AnalysedSession:
     report: SessionReport | None
     document: dict[str, Any] | None
     problem: str | None = None
-    profiles: tuple[StrokeProfile, ...] = ()
 
 
 def analyse_session(path: str | Path) -> AnalysedSession:
@@ -52,22 +49,15 @@ def analyse_session(path: str | Path) -> AnalysedSession:
     path = Path(path)
     session = load_session(path, recover=False)
     source = session_source(session)
+    method = session_method(session)
     try:
-        report = report_session(source)
+        report = report_session(source, method=method)
     except StationError as error:
-        return AnalysedSession(path, session, source.analysis, None, None, error.message)
+        return AnalysedSession(path, session, method, None, None, error.message)
     if report.empty:
         return AnalysedSession(
-            path, session, source.analysis, None, None, "the session has no accepted readings yet"
+            path, session, method, None, None, "the session has no accepted readings yet"
         )
-    profiles: tuple[StrokeProfile, ...] = ()
-    if report.kind == "linearity":
-        profiles = tuple(session_stroke_profiles(session))
     return AnalysedSession(
-        path=path,
-        session=session,
-        kind=report.kind,
-        report=report,
-        document=report.document(),
-        profiles=profiles,
+        path=path, session=session, kind=report.kind, report=report, document=report.document()
     )

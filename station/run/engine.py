@@ -3,8 +3,7 @@ actions and the instruments' readings into session events.
 
 The TUI, ``station capture`` and the demo's autopilot all drive a :class:`Runner`; how a step
 behaves lives in its kind's handler (:mod:`station.run.steps`), how a session is judged in its
-analysis kind (:mod:`station.verdicts`). The engine itself holds no step-kind or analysis-kind
-branch. Its rules:
+method (:mod:`station.methods`). The engine itself holds no step-kind or method branch. Its rules:
 
 * A step is *done* when its ``step`` event is on disk. What completes it is its handler's
   answer; the operator's next :class:`~station.run.state.Action` is too.
@@ -55,8 +54,9 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
-from station import verdicts
 from station.errors import StationError
+from station.methods import method_of
+from station.methods.contract import LiveVerdict
 from station.run.alarms import AlarmJournal
 from station.run.intake import InstrumentIntake
 from station.run.notices import LiveNotices
@@ -194,8 +194,8 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
         self._armed_at = float("-inf")
         self.header: Mapping[str, Any] = writer.snapshot().header
         self.config = analysis_config(self.header)
-        self.kind = verdicts.kind_of(setup.procedure.analysis)
-        self._live: verdicts.LiveVerdict = self.kind.live(self.config, setup.channels, self.header)
+        self.method = method_of(setup.procedure.analysis)
+        self._live: LiveVerdict = self.method.live(self.config, setup.channels, self.header)
         # The live analysis's changes, the last one computed (version, analysis, result,
         # problem) and the thread that sends it to the listener (station.run.notices).
         self._live_version = 0
@@ -449,17 +449,15 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
             if not complete:
                 self.say("warning", "Finished before every step was done.")
             self._close()
-            self._kind_finished()
+            self._method_finished()
             self._notify(None, analysis=True)
             return self.analysis_or_none()
 
-    def _kind_finished(self) -> None:
-        """What the analysis kind does with a finished session (a gauge check files itself in
-        the gauge register); its failure is a warning: the session is safe on disk."""
-        if self.kind.finished is None:
-            return
+    def _method_finished(self) -> None:
+        """What the method does with a finished session (a gauge study files itself in the
+        gauge register); its failure is a warning: the session is safe on disk."""
         try:
-            for sentence in self.kind.finished(self.path):
+            for sentence in self.method.finished(self.path):
                 self.say("info", sentence)
         except StationError as error:
             self.say("warning", error.message)
@@ -558,7 +556,9 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
             key = (record.step_id, record.placement)
             self._accepted_by_step[key] = self._accepted_by_step.get(key, 0) + 1
         self._accepted_count = len(accepted)
-        self._live = self._live.rebuilt([(r.values, r.cycle, r.times) for r in accepted], session)
+        self._live = self._live.rebuilt(
+            [(r.values, r.cycle, r.times, r.placement) for r in accepted], session
+        )
         self._live_changed()
 
     def zero_recorded(self, event: Mapping[str, Any]) -> None:
@@ -574,7 +574,7 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
         # alarms are on disk already: what the feeding raises again is not recorded twice.
         for record in self._cycles:
             if record.rejected is None:
-                self._live.add_cycle(record.values, record.cycle, record.times)
+                self._live.add_cycle(record.values, record.cycle, record.times, record.placement)
         self._live_changed()
 
     def _zero_config(self) -> bool:
@@ -584,7 +584,7 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
         if config.zero_uncertainty == self.config.zero_uncertainty:
             return False
         self.config = config
-        self._live = self.kind.live(self.config, self.setup.channels, self.header)
+        self._live = self.method.live(self.config, self.setup.channels, self.header)
         return True
 
     def _item_or_none(self) -> PlanItem | None:

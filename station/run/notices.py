@@ -104,7 +104,7 @@ class LiveNotices:
         return analysis, result, problem
 
     def analysis(self) -> Any:
-        """The live analysis of the session so far (the analysis kind's; for repeatability equal
+        """The live analysis of the session so far (the method's; for repeatability equal
         to the batch analysis of the session file). StationError before there is anything."""
         analysis, _, problem = self._analyse()
         if problem is not None:

@@ -200,7 +200,9 @@ class StepServices:
         # state that includes it (the last-reading line); the alarms follow, and the live
         # analysis comes from the analysis thread (station.run.notices).
         self._notify(self._last_event)
-        self._record_alarms(self._live.add_cycle(record.values, number, record.times), number)
+        self._record_alarms(
+            self._live.add_cycle(record.values, number, record.times, record.placement), number
+        )
         self._live_changed()
         return CycleOutcome(recorded=True, message=record.line(), cycle=record)
 

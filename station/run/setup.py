@@ -18,12 +18,12 @@ from station.instruments.gauge import GaugeSet, PortSpec
 from station.instruments.protocols import get_protocol
 from station.instruments.reader import DEFAULT_BACKOFF
 from station.instruments.triggers import TRIGGERS, Trigger
+from station.methods import method_of
 from station.procedures import Procedure, Step, discover_procedures
 from station.run.steps import handler_for
 from station.run.steps.base import PlanItem
 from station.session.header import header_limits
 from station.session.model import load_session
-from station.verdicts import kind_of
 
 
 @dataclass(frozen=True)
@@ -184,7 +184,7 @@ class SessionSetup:
     def header_fields(self) -> dict[str, Any]:
         """The session header's fields (the journal adds format, session id, created, prev).
         Each step kind in the plan may add fields of its own (a stroke step records the
-        deadband its split uses), and so may the analysis kind."""
+        deadband its split uses), and so may the method."""
         fields: dict[str, Any] = {
             "procedure": {
                 "id": self.procedure.id,
@@ -220,10 +220,8 @@ class SessionSetup:
         }
         for step in self.procedure.all_steps():
             fields.update(handler_for(step.kind).header_fields(self, step))
-        # And the analysis kind (a repeatability session: the gauge checks covering its gauges).
-        kind = kind_of(self.procedure.analysis)
-        if kind.header_fields is not None:
-            fields.update(kind.header_fields(fields))
+        # And the method's (a repeatability session: the gauge checks covering its gauges).
+        fields.update(method_of(self.procedure.analysis).header_fields(fields))
         return fields
 
 

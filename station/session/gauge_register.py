@@ -11,7 +11,12 @@ the calibration due date::
                                  "checks": [{"date": "2026-11-29", "result": "passed",
                                              "cg": 2.1, "cgk": 1.8, "bias": 0.00002,
                                              "bias_p": 0.31, "reference": 1.0,
-                                             "tolerance": 0.002, "session": "..."}]}}}
+                                             "tolerance": 0.002, "session": "..."}],
+                                 "studies": {"gauge_linearity": [{"date": "2026-11-30",
+                                             "result": "acceptable", "slope": 0.0002, ...}]}}}}
+
+Other studies of a gauge (a linearity and bias study over its travel) are kept beside its checks,
+per method (:func:`record_study`); they do not decide whether a check covers the gauge.
 
 A repeatability session names the gauge on each channel; :func:`coverage` looks each up
 (passed, failed, overdue or none) so the session can record which checks covered it and its
@@ -151,7 +156,6 @@ def record_check(
     (``{"url", "device"}``: the line and device channel the gauge was read on) lets a later
     session on that line find the gauge (:func:`gauges_on_ports`). Returns the entry recorded.
     StationError when the register cannot be read or written."""
-    key = _gauge_key(gauge)
     result = {"capable": "passed", "not capable": "failed"}.get(study.verdict, "no verdict")
     entry: dict[str, Any] = {
         "date": when.isoformat(),
@@ -163,6 +167,42 @@ def record_check(
     }
     if session:
         entry["session"] = session
+    return _file(path, gauge, entry, lambda record: (record, "checks"), calibration_due, port)
+
+
+def record_study(
+    path: Path,
+    gauge: str,
+    method: str,
+    entry: Mapping[str, Any],
+    *,
+    calibration_due: dt.date | str | None = None,
+    port: Mapping[str, str] | None = None,
+) -> dict[str, Any]:
+    """Add a study other than a Type-1 check (``method``: the study's method, e.g.
+    ``gauge_linearity``; ``entry``: its date, result and figures) of ``gauge`` to the register
+    at ``path``, beside its checks (newest last, at most :data:`HISTORY` per method);
+    ``calibration_due`` updates the gauge's due date, ``port`` is where it was read. Returns
+    the entry recorded. StationError when the register cannot be read or written."""
+
+    def place(record: dict[str, Any]) -> tuple[dict[str, Any], str]:
+        return record.setdefault("studies", {}), method
+
+    return _file(path, gauge, dict(entry), place, calibration_due, port)
+
+
+def _file(
+    path: Path,
+    gauge: str,
+    entry: dict[str, Any],
+    place: Any,
+    calibration_due: dt.date | str | None,
+    port: Mapping[str, str] | None,
+) -> dict[str, Any]:
+    """Append ``entry`` to the list ``place(gauge's record)`` names (its holder and key), with
+    the port it was read on, under the register's lock; the gauge's due date updated. A session
+    filed again (``station gauges record`` after the finish filed it) replaces its own entry."""
+    key = _gauge_key(gauge)
     if port:
         entry["port"] = {"url": str(port["url"]), "device": str(port["device"])}
     due = None if calibration_due in (None, "") else parse_date(calibration_due, "calibration due")
@@ -173,7 +213,10 @@ def record_check(
             record = content["gauges"].setdefault(key, {"calibration_due": None, "checks": []})
             if due is not None:
                 record["calibration_due"] = due.isoformat()
-            record["checks"] = [*record.get("checks", []), entry][-HISTORY:]
+            holder, name = place(record)
+            session = entry.get("session")
+            kept = [e for e in holder.get(name, []) if not _same_session(e, session)]
+            holder[name] = [*kept, entry][-HISTORY:]
             _write(path, content)
     except OSError as error:
         reason = error.strerror or str(error)
@@ -181,6 +224,31 @@ def record_check(
             reason = "a symbolic link is in the way"
         raise StationError(f"cannot write the gauge register {path}: {reason}.") from None
     return entry
+
+
+def _same_session(entry: Any, session: str | None) -> bool:
+    return bool(session) and isinstance(entry, Mapping) and entry.get("session") == session
+
+
+def latest_studies(record: Mapping[str, Any] | None) -> dict[str, dict[str, Any]]:
+    """The newest study of each method a register entry holds (none for a gauge with only
+    Type-1 checks, or an entry from before studies were kept)."""
+    studies = (record or {}).get("studies")
+    if not isinstance(studies, Mapping):
+        return {}
+    return {
+        str(method): dict(entries[-1])
+        for method, entries in studies.items()
+        if isinstance(entries, list) and entries and isinstance(entries[-1], Mapping)
+    }
+
+
+def study_sentence(method: str, entry: Mapping[str, Any]) -> str:
+    """``gauge_linearity: acceptable on 2026-11-30`` (its summary, where the entry has one)."""
+    name = "".join(ch if ch.isprintable() else "?" for ch in method)
+    summary = entry.get("summary")
+    tail = f" ({summary})" if isinstance(summary, str) and summary else ""
+    return f"{name}: {entry.get('result', 'no result')} on {entry.get('date', '?')}{tail}"
 
 
 @dataclass(frozen=True)
@@ -443,6 +511,16 @@ def gauge_block(
         )
     ]
     return (("GAUGE CHECKS (the gauge register when the session began)", *lines),)
+
+
+def port_of(header: Mapping[str, Any], channel: str) -> dict[str, str] | None:
+    """The line and device channel ``channel`` was read on, as a session's header records its
+    instruments (``{"url", "device"}``), or None when it records none."""
+    for recorded in (header.get("instruments") or {}).get("ports") or ():
+        for device, mapped in dict(recorded.get("map") or {}).items():
+            if mapped == channel:
+                return {"url": str(recorded.get("url")), "device": str(device)}
+    return None
 
 
 def filed_line(session_id: str, path: Path | None = None) -> str:

@@ -79,7 +79,7 @@ class SessionHeader:
     procedure_version: str
     procedure_sha256: str
     analysis: str | None
-    """The analysis kind the procedure declared when the session began (None in old files)."""
+    """The method the procedure declared when the session began (None in old files)."""
     robot: str
     operator: str
     unit: str

@@ -303,7 +303,9 @@ class StationApp(App[int]):
     def catalog(self) -> ProcedureCatalog:
         """The installed procedures (built-in plus ``--procedures`` folders), loaded once."""
         if self._catalog is None:
-            from station.procedures import discover_procedures  # deferred: start-up time
+            # Deferred: start-up time. The methods first: procedure files name them.
+            import station.methods  # noqa: F401
+            from station.procedures import discover_procedures
 
             self._catalog = discover_procedures(self.config.procedure_dirs)
         return self._catalog
@@ -315,7 +317,7 @@ class StationApp(App[int]):
         lab = self.config.demo_lab
         if demo is None or lab is None or procedure_id in (None, demo.procedure):
             return demo
-        fixture = lab.fixture(procedure_id)
+        fixture = lab.fixture(self.catalog.get(procedure_id).analysis)
         return DemoPort(
             url=fixture.url,
             protocol=fixture.protocol,
@@ -549,7 +551,7 @@ class StationApp(App[int]):
             return self._latest_analysis
 
     def live_result(self) -> Any:
-        """The analysis kind's own live result (per-stroke straightness...), or None."""
+        """The method's own live result (per-stroke straightness...), or None."""
         with self._state_lock:
             return self._latest_result
 

@@ -1,10 +1,10 @@
 """``station demo --autopilot``: walk the procedure by itself, through the operator's own actions.
 
 Each move is what a key would do on the screen in front (Enter on the home screen's first new
-session, F2 on the set-up, Enter on each checklist step, typing the simulated teach pendant's
-X, Y, Z at an input step, Space for each cycle or capture, ``r`` with a reason once, streaming
-the strokes of a linearity run, ``f`` at the end), at a watchable pace, and the walk stops on the
-summary. Nothing
+session, F2 on the set-up, Enter on each checklist step, typing what the simulated set-up shows
+at an input step (the teach pendant's X, Y, Z, a master's size), Space for each cycle or
+capture, ``r`` with a reason once, streaming the strokes of a linearity run, ``f`` at the end),
+at a watchable pace, and the walk stops on the summary. Nothing
 is faked: the runner, the instruments and the session file are the real ones.
 """
 
@@ -85,20 +85,28 @@ async def run_autopilot(app: StationApp) -> None:
                 continue
             elif state.progress is None or not state.progress.complete:
                 screen.action_capture()
+            elif state.current is not None and state.current.index < len(state.steps) - 1:
+                screen.action_go_on()  # a block's cycles step: the next placement's steps
             else:
                 screen.action_finish()
 
 
 def _fill_inputs(app: StationApp, screen: object) -> None:
-    """Type into the empty input fields what the simulated teach pendant shows (X, Y, Z into
-    the fields named x, y, z), else a demo value."""
+    """Type into the empty input fields what the simulated set-up shows (the teach pendant's
+    X, Y, Z into the fields named x, y, z; a master's size); where it shows nothing, a demo
+    value."""
 
     state = app.current_state()
     fixture = app.demo_fixture
     placement = state.current.placement if state is not None and state.current else None
-    shown = fixture.pendant(placement) if fixture is not None else None
-    pendant = dict(zip("xyz", shown.pendant, strict=True)) if shown is not None else {}
+    unit = str(app.session_header.get("unit") or "in")
+    display = fixture.shows(placement, unit) if fixture is not None else None
+    values = dict(display.values) if display is not None else {}
     for widget in screen.query("#step-inputs Input"):  # type: ignore[attr-defined]
         if isinstance(widget, Input) and not widget.value:
             name = str(widget.id).removeprefix("input-")
-            widget.value = str(pendant[name]) if name in pendant else "0"
+            if name in values:
+                widget.value = str(values[name])
+            elif display is None:
+                widget.value = "0"  # nothing shown to copy: a demo value
+            # else: a field the set-up shows nothing for is left empty (an optional one)

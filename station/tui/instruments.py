@@ -6,7 +6,7 @@ reader); nothing here parses a frame or writes a file.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -14,20 +14,17 @@ from station.errors import StationError
 from station.text import format_value
 
 DEMO_PROTOCOL = "mitutoyo"
-DEMO_CHANNEL_MAP = {"1": "x", "2": "y", "3": "z"}
-BAR_CHANNEL_MAP = {"1": "h", "2": "v", "3": "s"}
-BAR_PUSH_RATE = 200.0
-"""Sets a second the simulated bar's indicators and scale send (a linear-scale counter's rate)."""
 TEST_CAPTURES = 5
 DEMO_GAUGE_NOISE = 0.3
 """The demo indicators' own reading noise, in resolutions (σ): a robot at rest looks at rest."""
 
-DEMO_PROCEDURES = {
-    "repeatability": "three dial indicators in one fixture",
-    "relative_accuracy": "two fixtures and a teach pendant",
-    "linearity": "a bar, indicators h and v, a scale s",
-}
-"""The procedures ``station demo`` simulates, with the set-up each one's simulator models."""
+
+def demo_methods() -> dict[str, str]:
+    """The methods ``station demo`` simulates, with the set-up each one's simulator models in
+    words (:attr:`Method.demo_words <station.methods.contract.Method.demo_words>`)."""
+    from station.methods import methods  # deferred: the methods load numpy
+
+    return {name: m.demo_words for name, m in methods().items() if m.demo_words}
 
 
 @dataclass
@@ -38,17 +35,19 @@ class DemoFixture:
     protocol: str
     channel_map: dict[str, str]
     simulator: Any
-    procedure: str = "repeatability"
+    method: str = ""
+    """The method whose simulated set-up this is ("" for one a test started itself)."""
     trigger: str = "poll"
     description: str = "simulated dial indicators (seeded)"
+    display: Callable[[Any, int | None, str], Any] | None = None
+    """What the set-up shows at an input step (the method's ``DemoRig.display``)."""
 
-    def pendant(self, placement: int | None) -> Any:
-        """What the simulated teach pendant shows at ``placement`` (a ``Placement`` with
-        ``pendant`` and ``pendant_text()``), or None when this set-up has no pendant."""
-        placement_of = getattr(self.simulator.model, "placement_of", None)
-        if placement_of is None or placement is None:
+    def shows(self, placement: int | None, unit: str) -> Any:
+        """What the simulated set-up shows the operator at ``placement`` for an input step (a
+        ``DemoDisplay``: the teach pendant's X, Y, Z, a master's size), or None."""
+        if self.display is None:
             return None
-        return placement_of(placement)
+        return self.display(self.simulator.model, placement, unit)
 
     def follow(self, state: Any) -> None:
         """Put the still simulated robot where the procedure's state says the operator has
@@ -68,7 +67,9 @@ class DemoFixture:
         elif hasattr(model, "rest_of"):
             # Blocks of a rest where the station zeroes, then returns (two fixtures: one).
             done = state.progress.done if state.progress is not None else 0
-            returned = min(done + 1, getattr(model, "cycles", 1)) if capturing else 0
+            # Returns per block: the model's cycles (None: no end, one block), else one.
+            cap = getattr(model, "cycles", 1)
+            returned = (done + 1 if cap is None else min(done + 1, cap)) if capturing else 0
             rest = model.rest_of(state.placement or 1, returned)
         elif isinstance(state.next_cycle, int) and capturing:
             rest = state.next_cycle
@@ -114,89 +115,69 @@ def running_fixture(url: str) -> DemoFixture | None:
 def start_demo_fixture(
     seed: int = 1990,
     *,
-    procedure: str = "repeatability",
+    method: str = "",
     unit: str = "in",
     resolution: float = 0.0001,
     link: str | None = None,
     stroke_points: int = 400,
     cycle_period: float | None = None,
 ) -> DemoFixture:
-    """Start the simulator of ``procedure``'s set-up on a pseudo-terminal, seeded.
-
-    * repeatability (and any other procedure): a robot that repeats well in x, sits a little
-      off nominal in y, and warms up (drifts) in z, so the demo shows each kind of verdict and
-      a control-chart alarm;
-    * relative_accuracy: two fixtures with a pendant display, an error that grows with the
-      distance moved, and a preload at home that only zeroing takes out;
-    * linearity: a bar with a bow, a sag and a linear scale, a robot path with a wobble,
-      pushing ``BAR_PUSH_RATE`` sets a second; ``stroke_points`` points per stroke.
+    """Start the simulator of ``method``'s set-up (its :meth:`demo_rig
+    <station.methods.contract.Method.demo_rig>`; the default method's for one without, or for
+    "") on a pseudo-terminal, seeded; ``stroke_points`` points per streamed stroke.
 
     ``link``: a fixed path for the pty (a symlink), instead of ``/dev/pts/N``.
-    ``cycle_period``: the repeatability robot leaves the fixture and comes back every so many
-    seconds (its indicators at free travel while away, a short overshoot on return), and the
-    set-up takes the ``arrival`` trigger: the station counts the robot's round trips. Without
-    it every poll is a new rest position (Space per cycle).
+    ``cycle_period``: a robot that can run a playback loop leaves the fixture and comes back
+    every so many seconds (its indicators at free travel while away, a short overshoot on
+    return), and the set-up takes the ``arrival`` trigger: the station counts the robot's
+    round trips. Without it every poll is a new rest position (Space per cycle).
     """
     # Deferred: the gauge layer (about 80 ms) loads when a line is opened, off the start path.
     from station.instruments.motion import CycleMotion, default_free_travel
     from station.instruments.protocols import get_protocol
-    from station.instruments.simulator import (
-        AxisModel,
-        BarModel,
-        FixtureModel,
-        GaugeSpec,
-        Simulator,
-        TwoFixtureModel,
-    )
+    from station.instruments.simulator import GaugeSpec, Simulator
+    from station.methods import BUILT_IN, methods
 
     protocol = get_protocol(DEMO_PROTOCOL)
     # The indicators' own noise: readings at rest scatter by about a third of a resolution.
     gauge = GaugeSpec(
         resolution=resolution, low=-0.5, high=0.5, unit=unit, noise=DEMO_GAUGE_NOISE * resolution
     )
-    channel_map, trigger, push_rate = DEMO_CHANNEL_MAP, "poll", 0.0
-    if procedure == "relative_accuracy":
-        # Mitutoyo has no zero command: the station zeroes in software from readings at home,
-        # so the preload really has to be zeroed out.
-        model: Any = TwoFixtureModel(preload=0.05, gauge=gauge, seed=seed)
-        description = "two simulated fixtures and a teach pendant (seeded)"
-    elif procedure == "linearity":
-        model = BarModel(points=stroke_points, indicator=gauge)
-        channel_map, trigger, push_rate = BAR_CHANNEL_MAP, "push", BAR_PUSH_RATE
-        description = "a simulated parallel bar with indicators h, v and a scale s (seeded)"
-    else:
-        model = FixtureModel(
-            {
-                "x": AxisModel(bias=0.0, noise=0.00022),
-                "y": AxisModel(bias=0.00025, noise=0.00036, skew=2.0),
-                "z": AxisModel(bias=-0.0002, noise=0.00012, drift=0.0005, drift_tau=6.0),
-            },
-            gauge,
-        )
-        description = "simulated dial indicators (seeded)"
-    motion = None
-    if cycle_period is not None and isinstance(model, FixtureModel):
+    chosen = methods().get(method)
+    rig = chosen.demo_rig(gauge, seed, stroke_points=stroke_points) if chosen else None
+    if rig is None:
+        chosen = BUILT_IN[0]
+        rig = chosen.demo_rig(gauge, seed, stroke_points=stroke_points)
+        assert rig is not None, "the default method has a simulated set-up"
+    trigger, description, motion = rig.trigger, rig.description, None
+    if cycle_period is not None and rig.loops:
         motion = CycleMotion(cycle_period, default_free_travel(unit), 20 * resolution)
         trigger = "arrival"
         description = f"simulated dial indicators, the robot back every {cycle_period:g} s (seeded)"
     simulator = Simulator(
-        protocol, model, seed=seed, channel_map=channel_map, push_rate=push_rate, motion=motion
+        protocol,
+        rig.model,
+        seed=seed,
+        channel_map=dict(rig.channel_map),
+        push_rate=rig.push_rate,
+        motion=motion,
     )
     url = simulator.start_pty(link=link)
     fixture = DemoFixture(
         url=url,
         protocol=DEMO_PROTOCOL,
-        channel_map=dict(channel_map),
+        channel_map=dict(rig.channel_map),
         simulator=simulator,
-        procedure=procedure,
+        method=chosen.name,
         trigger=trigger,
         description=description,
+        display=rig.display,
     )
     return track(fixture)
 
 
 class DemoLab:
-    """The demo's simulators, one per procedure, each started the first time it is asked for
+    """The demo's simulators, one per method, each started the first time it is asked for
     (so the set-up's procedure picker switches the simulated set-up with the procedure)."""
 
     def __init__(
@@ -212,18 +193,21 @@ class DemoLab:
         self.cycle_period = cycle_period
         """The repeatability robot's round trip in seconds (None: it does not move)."""
         self.link_prefix = link_prefix
-        """When set, each simulator's port is also a link named ``<prefix>-<procedure>`` (a
-        name that does not change from run to run, for the screen snapshots)."""
+        """When set, each simulator's port is also a link named ``<prefix>-<method>`` (a name
+        that does not change from run to run, for the screen snapshots)."""
         self._fixtures: dict[str, DemoFixture] = {}
 
-    def fixture(self, procedure: str) -> DemoFixture:
-        """The running simulator for ``procedure`` (a fixture model for unknown ones)."""
-        key = procedure if procedure in DEMO_PROCEDURES else "repeatability"
+    def fixture(self, method: str) -> DemoFixture:
+        """The running simulator for ``method``'s set-up (the default method's for a method
+        without one)."""
+        from station.methods import BUILT_IN  # deferred: the methods load numpy
+
+        key = method if method in demo_methods() else BUILT_IN[0].name
         if key not in self._fixtures:
             link = f"{self.link_prefix}-{key}" if self.link_prefix else None
             self._fixtures[key] = start_demo_fixture(
                 self.seed,
-                procedure=key,
+                method=key,
                 stroke_points=self.stroke_points,
                 cycle_period=self.cycle_period,
                 link=link,

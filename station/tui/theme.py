@@ -50,12 +50,19 @@ _COLOUR_VERDICTS = {
     "NOT CAPABLE": "bold reverse red",
     "UNDEFINED": "bold underline yellow",
     "PROVISIONAL": "bold underline yellow",
+    # A gauge study's own verdict, styled as the capability words it stands beside.
+    "ACCEPTABLE": "bold green",
+    "NOT ACCEPTABLE": "bold reverse red",
+    "INCONCLUSIVE": "bold underline yellow",
 }
 _PLAIN_VERDICTS = {
     "CAPABLE": "bold",
     "NOT CAPABLE": "bold reverse",
     "UNDEFINED": "bold underline",
     "PROVISIONAL": "bold underline",
+    "ACCEPTABLE": "bold",
+    "NOT ACCEPTABLE": "bold reverse",
+    "INCONCLUSIVE": "bold underline",
 }
 _COLOUR_ALARMS = {"head": "bold reverse red", "line": "bold red", "none": ""}
 _PLAIN_ALARMS = {"head": "bold reverse", "line": "bold", "none": ""}

@@ -124,4 +124,6 @@ def test_gain_schedule_through_analyze(tmp_path: Path):
 
 def test_reference_belongs_to_the_gauge_check(gauge_csv: Path):
     result = analyze(gauge_csv, "--reference", "0.1")
-    assert result.returncode == 2 and "--reference is the reference size" in result.stderr
+    assert result.returncode == 2
+    assert "--reference is not an option of --procedure repeatability" in result.stderr
+    assert "it belongs to --procedure gauge_check." in result.stderr

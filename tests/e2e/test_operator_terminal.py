@@ -146,6 +146,21 @@ def test_the_tui_exits_128_plus_the_signal(tmp_path: Path, signum: int, code: in
         station.close()
 
 
+def test_station_tui_opens_the_home_screen_and_ctrl_c_quits(tmp_path: Path) -> None:
+    """``station tui`` (what plain ``station`` runs) on a real terminal: the home screen names
+    the sessions folder, and Ctrl+C on it quits at once, exit 0."""
+    station = PtyProcess(
+        [sys.executable, "-m", "station", "tui", "--sessions", str(tmp_path)], tmp_path
+    )
+    try:
+        station.wait_for("New session", timeout=30)
+        station.wait_for("Sessions folder", timeout=10)
+        os.write(station._master, b"\x03")
+        assert station.process.wait(20) == 0
+    finally:
+        station.close()
+
+
 def test_the_stations_own_terminal_is_refused_as_a_gauge_line(tmp_path: Path) -> None:
     """Finding 10: a pseudo-terminal number reused by the operator's own window, typed or
     recorded as the gauge port, was opened; the poll request "1\\r" was drawn at the top-left

@@ -8,6 +8,7 @@ a short trial run of each procedure and reads the verdict words off the summary.
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import shlex
@@ -167,5 +168,30 @@ def test_demo_autopilot_count_5_ends_on_the_verdict(
             _station("verify", str(sessions[0])), capture_output=True, text=True, cwd=ROOT
         )
         assert verify.returncode == 0, verify.stdout + verify.stderr
+    finally:
+        pane.close()
+
+
+def test_demo_autopilot_walks_the_gauge_linearity_study(tmp_path: Path) -> None:
+    """``station demo --procedure gauge_linearity --autopilot``: the bench's five masters, each
+    size copied from the simulated bench into its input step, twelve seatings each, end on the
+    study's own verdict (the demo indicator reads long: a slope of 0.0008), filed in the demo
+    folder's own gauge register."""
+    command = ["demo", "--procedure", "gauge_linearity", "--autopilot", "--pace", "0.05"]
+    pane = Pane(_station(*command, "--sessions", str(tmp_path)), tmp_path)
+    try:
+        screen = pane.wait_for("Verdict:", timeout=300)
+        time.sleep(0.5)  # the summary paints in a few frames
+        screen = pane.wait_for("Export report", timeout=10)
+        assert "Verdict: NOT ACCEPTABLE" in screen, screen
+        assert "5 masters" in screen, screen
+        (session,) = (tmp_path / "demo").glob("*.jsonl")
+        analysed = subprocess.run(
+            _station("analyze", str(session), "--json"), capture_output=True, text=True, cwd=ROOT
+        )
+        study = json.loads(analysed.stdout)["gauge_linearity"]
+        assert [b["reference"] for b in study["biases"]] == [0.1, 0.3, 0.5, 0.7, 0.9]
+        register = json.loads((tmp_path / "demo" / "gauges.json").read_text())
+        assert "gauge_linearity" in register["gauges"]["DEMO-IND-1"]["studies"]
     finally:
         pane.close()

@@ -8,6 +8,7 @@ import sys
 import zipfile
 from pathlib import Path
 
+import numpy
 import pytest
 from helpers import CHECK_STEP as CHECK
 from helpers import PROBE_HEAD as HEAD
@@ -292,23 +293,29 @@ def test_a_wheel_carries_the_builtin_procedures(tmp_path: Path) -> None:
     assert not missing, f"not in the wheel: {sorted(missing)}"
 
     # Installed from the wheel alone (no checkout beside it), the procedures are still found.
+    # Without site (so no editable install of the checkout), the dependencies' folder is added
+    # after the wheel's: the methods that procedure files name import numpy.
     target = tmp_path / "installed"
     zipfile.ZipFile(wheel).extractall(target)
+    dependencies = str(Path(numpy.__file__).resolve().parent.parent)
     probe = (
-        "import sys; sys.path.insert(0, sys.argv[1]); "
+        "import sys; sys.path.insert(0, sys.argv[1]); sys.path.append(sys.argv[2]); "
+        "import station.methods; "
         "from station.procedures import builtin_procedures_dir, discover_procedures; "
-        "print(builtin_procedures_dir()); print(*discover_procedures(use_env=False).ids())"
+        "print(builtin_procedures_dir()); print(*discover_procedures(use_env=False).ids()); "
+        "print(station.methods.__file__)"
     )
     found = subprocess.run(
-        [sys.executable, "-S", "-c", probe, str(target)],
+        [sys.executable, "-S", "-c", probe, str(target), dependencies],
         capture_output=True,
         text=True,
         cwd=tmp_path,
         timeout=60,
     )
     assert found.returncode == 0, found.stderr
-    folder, ids = found.stdout.splitlines()
+    folder, ids, methods = found.stdout.splitlines()
     assert Path(folder) == target / "station" / "builtin_procedures"
+    assert Path(methods).is_relative_to(target)
     assert "repeatability" in ids.split()
 
 

@@ -182,8 +182,8 @@ def test_a_site_copy_of_linearity_under_another_id_gets_the_linearity_report(
 ) -> None:
     """The report follows the procedure's ``analysis``, never its id: a site's own copy of
     linearity.toml (id "bar-check") gets the linearity report from capture and analyze."""
+    from station.methods import analyze_session_file
     from station.procedures import builtin_procedures_dir
-    from station.verdicts import analyze_session_file
 
     folder = tmp_path / "site"
     folder.mkdir()

@@ -7,8 +7,8 @@ import threading
 
 import station.analysis.live as live_module
 from station.analysis.document import to_json
+from station.methods import analyze_session_file
 from station.run import Runner, RunnerNotice
-from station.verdicts import analyze_session_file
 
 from .conftest import cycles_only_procedure, setup_for
 

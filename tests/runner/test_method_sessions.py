@@ -17,9 +17,9 @@ from station.instruments.gauge_bench import GaugeBenchModel
 from station.instruments.joint_model import faulty_arm
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import GaugeSpec, Simulator
+from station.methods import analyze_session_file
 from station.session.gauge_register import coverage, coverage_lines, load_register
 from station.session.model import load_session
-from station.verdicts import analyze_session_file
 
 from .playing import play_capture
 
@@ -152,6 +152,113 @@ def test_gauge_check_session_is_analysed_and_filed(
     line = coverage_lines(status)[0]
     assert ("gauge check passed on" in line) is capable
     assert analyze_session_file(path).count == "25 readings"
+
+
+def test_gauges_record_files_a_finished_gauge_check_once(tmp_path: Path):
+    """``station gauges record`` files the study in the register it is given, and filing the
+    same session again replaces its entry (the finish already filed it in the default one)."""
+    done, path = played(
+        bench(),
+        25,
+        tmp_path / "sessions",
+        "gauge_check",
+        *("--cycles", "25", "--input", "gauge=MIT-0042", "--input", "reference=0.1"),
+        *("--input", "tolerance=0.004"),
+    )
+    assert done.returncode == 0, done.stderr
+    other = tmp_path / "other-register.json"
+    for _ in range(2):
+        recorded = gauges("record", str(path), "--register", str(other))
+        assert recorded.returncode == 0, recorded.stderr
+        assert "Gauge check of MIT-0042: passed on" in recorded.stdout
+        assert f"filed in the gauge register {other}" in recorded.stdout
+    checks = load_register(other)["gauges"]["MIT-0042"]["checks"]
+    assert len(checks) == 1 and checks[0]["session"] == load_session(path).session_id
+    again = gauges("record", str(path))
+    assert again.returncode == 0, again.stderr
+    default = load_register(Path(os.environ["STATION_GAUGES"]))["gauges"]["MIT-0042"]["checks"]
+    assert len(default) == 1
+    listed = gauges("list", "--register", str(other))
+    assert listed.returncode == 0 and "gauge MIT-0042: gauge check passed on" in listed.stdout
+    status = gauges("status", "MIT-0042", "--register", str(other), "--json")
+    assert status.returncode == 0, status.stderr
+    assert json.loads(status.stdout)["gauges"][0]["state"] == "passed"
+    unknown = gauges("status", "MIT-0042", "DIAL-9", "--register", str(other))
+    assert unknown.returncode == 1 and "DIAL-9: no gauge check on record" in unknown.stdout
+
+
+def test_gauges_record_refuses_what_is_no_gauge_study(tmp_path: Path):
+    fixture, url = simulate("--unit", "in", "--resolution", "0.0001")
+    try:
+        path, _ = capture(url, tmp_path / "sessions", "repeatability", "--cycles", "2")
+    finally:
+        stop_simulator(fixture)
+    refused = gauges("record", str(path))
+    assert refused.returncode == 2
+    assert "is a repeatability session, which files nothing in the gauge register" in refused.stderr
+
+
+MASTERS = (0.1, 0.3, 0.5, 0.7, 0.9)
+"""The linearity study's gauge blocks (in), across the bench indicator's 1 in of travel."""
+
+
+def test_a_gauge_linearity_study_headless_recovers_the_bench_slope(tmp_path: Path):
+    """Five gauge blocks, twelve seatings each, on a bench whose indicator reads a block of
+    size r as r + 0.0001 + 0.001·r: the study recovers the slope and bias within their
+    intervals, calls the gauge not acceptable against a 0.004 in tolerance, and files itself
+    in the gauge register beside the gauge's checks (``station gauges list`` shows it)."""
+    gauge = GaugeSpec(0.0001, -0.5, 1.0, "in", noise=0.00002)
+    model = GaugeBenchModel(MASTERS, bias=0.0001, slope=0.001, noise=0.00004, gauge=gauge)
+    simulator = Simulator(get_protocol("idh"), model, seed=2, channel_map={"1": "x"})
+    sizes = [f"{n}:reference={size}" for n, size in enumerate(MASTERS, start=1)]
+    done, path = played(
+        simulator,
+        len(MASTERS) * 12,
+        tmp_path / "sessions",
+        "gauge_linearity",
+        *("--input", "gauge=MIT-0042", "--input", "tolerance=0.004"),
+        *(arg for size in sizes for arg in ("--input", size)),
+    )
+    assert done.returncode == 0, done.stderr
+    assert "GAUGE LINEARITY AND BIAS STUDY: NOT ACCEPTABLE" in done.stdout
+    assert "Gauge linearity study of MIT-0042: NOT ACCEPTABLE" in done.stdout
+    study = analyze_json(path)["gauge_linearity"]
+    assert [b["reference"] for b in study["biases"]] == list(MASTERS)
+    assert all(b["n"] == 12 for b in study["biases"])
+    t = 2.002  # Student's t, 95 %, 58 degrees of freedom
+    assert abs(study["slope"] - 0.001) <= t * study["slope_se"]
+    # The zero is the plate's, read by the gauge at its step: the intercept is the bias.
+    assert abs(study["intercept"] - 0.0001) <= t * study["intercept_se"] + 0.0001
+    assert study["acceptable"] is False
+    assert analyze_session_file(path).count == "5 masters"
+    register = Path(os.environ["STATION_GAUGES"])
+    entry = load_register(register)["gauges"]["MIT-0042"]["studies"]["gauge_linearity"][-1]
+    assert entry["result"] == "not acceptable" and entry["references"] == list(MASTERS)
+    assert entry["port"]["url"] == simulator.url
+    listed = gauges("list", "--json")
+    (gauge,) = json.loads(listed.stdout)["gauges"]
+    assert gauge["studies"]["gauge_linearity"]["session"] == load_session(path).session_id
+    text = gauges("list").stdout
+    assert "  gauge_linearity: not acceptable on" in text
+    other = tmp_path / "other-register.json"
+    recorded = gauges("record", str(path), "--register", str(other))
+    assert recorded.returncode == 0, recorded.stderr
+    assert "Gauge linearity study of MIT-0042: NOT ACCEPTABLE" in recorded.stdout
+    assert load_register(other)["gauges"]["MIT-0042"]["studies"]["gauge_linearity"]
+    # Its wide export is the table the study reads back, and gives the same figures.
+    table = tmp_path / "study.csv"
+    exported = subprocess.run(
+        [*STATION, "export", str(path), "--csv", "-o", str(table)],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert exported.returncode == 0, exported.stderr
+    again = subprocess.run(
+        [*STATION, "analyze", str(table), "--procedure", "gauge_linearity",
+         "--tolerance", "0.004", "--resolution", "0.0001", "--unit", "in", "--json"],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert again.returncode == 0, again.stderr
+    assert json.loads(again.stdout)["gauge_linearity"]["slope"] == pytest.approx(study["slope"])
 
 
 @pytest.mark.parametrize("protocol", ["idh", "mitutoyo"])

@@ -15,10 +15,10 @@ from helpers import STATION
 from station.analysis.document import to_json
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import GaugeSpec, Simulator, TwoFixtureModel
+from station.methods import analyze_session_file
 from station.procedures import discover_procedures
 from station.run import PortSetup, Runner, SessionSetup
 from station.session.model import load_session
-from station.verdicts import analyze_session_file
 
 from .playing import play_capture
 

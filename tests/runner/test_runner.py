@@ -311,7 +311,7 @@ def test_push_trigger_records_sets_without_capture_calls(gauges_for, tmp_path):
 def test_runner_imports_no_ui():
     """The runner is domain code: importing it (and the capture command) loads no UI."""
     code = (
-        "import sys, station.run, station.verdicts, station.commands.capture\n"
+        "import sys, station.run, station.methods, station.commands.capture\n"
         "ui = [m for m in sys.modules if m.split('.')[0] in ('textual', 'plotext')"
         " or m.startswith('station.tui')]\n"
         "print(ui)"

@@ -11,11 +11,11 @@ import pytest
 from station.analysis.monitor import replay_live_alarms
 from station.analysis.report import format_report
 from station.errors import StationError
+from station.methods import analyze_session_file
 from station.run import Runner
 from station.session.alarms import live_events, recorded_alarms
 from station.session.header import analysis_config
 from station.session.model import load_session
-from station.verdicts import analyze_session_file
 
 from .conftest import cycles_only_procedure, setup_for
 

@@ -123,9 +123,9 @@ def test_the_zero_shows_on_the_dashboard_the_summary_and_the_reports(
     import subprocess
     import sys
 
+    from station.methods import analyze_session_file
     from station.tui.screens.dashboard import DashboardView
     from station.tui.screens.summary import SummaryView
-    from station.verdicts import analyze_session_file
 
     runner, gauges = _start(tmp_path, moving.url)
     try:

@@ -10,6 +10,7 @@ import pytest
 
 from station.analysis.monitor import LiveMonitor, replay_live_alarms
 from station.errors import StationError
+from station.methods import analyze_session_file
 from station.session.alarms import (
     ack_fields,
     format_recorded_alarms,
@@ -19,7 +20,6 @@ from station.session.alarms import (
 from station.session.header import analysis_config
 from station.session.journal import SessionWriter
 from station.session.model import load_session
-from station.verdicts import analyze_session_file
 
 from .conftest import session_header_fields
 

@@ -538,7 +538,7 @@ async def test_relative_accuracy_at_80x24_pendant_fields_instruction_and_capture
             await tui.wait_until(pilot, lambda: getattr(app.screen.focused, "id", "") == "input-x")
             await pilot.pause(0.1)
             panel = app.screen.query_one("#step-panel")
-            shown = fixture.pendant(app.runner.state().current.placement)
+            shown = fixture.simulator.model.placement_of(app.runner.state().current.placement)
             # Typed by keyboard: each field in view as it is typed into.
             for axis, value in zip("xyz", shown.pendant, strict=True):
                 field = app.screen.focused

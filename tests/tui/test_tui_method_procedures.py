@@ -170,6 +170,47 @@ async def test_gauge_check_through_the_tui(tmp_path: Path, simulator: str, tui) 
     assert entry["result"] == "passed" and entry["port"] == {"url": simulator, "device": "1"}
 
 
+MASTERS = ("0.1", "0.3", "0.5", "0.7", "0.9")
+"""The linearity study's gauge blocks (in)."""
+
+
+@pytest.mark.parametrize(
+    "simulator",
+    [("--model", "gauge-bench", "--reference", ",".join(MASTERS), "--slope", "0.001",
+      "--noise", "0.00003", "--seed", "3")],
+    indirect=True,
+)  # fmt: skip
+async def test_gauge_linearity_study_through_the_tui(tmp_path: Path, simulator: str, tui) -> None:
+    """The five masters guided in turn (the set-up counts masters, each master's size typed,
+    twelve seatings each, the bench following the steps), and the summary's verdict is the
+    study's own; the study stands in the gauge register."""
+    app = tui_app(tmp_path)
+
+    def typed(placement: int | None) -> dict[str, str]:
+        if placement is None:
+            return {"gauge": "MIT-0042", "tolerance": "0.004"}
+        return {"reference": MASTERS[placement - 1]}
+
+    async with app.run_test(size=(80, 24)) as pilot:
+        await run_procedure(pilot, tui, "gauge_linearity", simulator, "1=x", "5", typed)
+        report = text_of(app, "#summary-report")
+        assert "GAUGE LINEARITY AND BIAS STUDY: NOT ACCEPTABLE" in report
+        assert "5 masters" in text_of(app, "#summary-title")
+        verdict = text_of(app, "#summary-verdict")
+        assert "Verdict: NOT ACCEPTABLE" in verdict and "proven at" in verdict
+        view = app.screen.view
+    study = analyze_json(view.path)["gauge_linearity"]
+    assert [b["reference"] for b in study["biases"]] == [float(m) for m in MASTERS]
+    assert all(b["n"] == 12 for b in study["biases"])
+    assert study["slope"] == pytest.approx(0.001, abs=3 * study["slope_se"])
+    register = load_register(Path(os.environ["STATION_GAUGES"]))
+    entry = register["gauges"]["MIT-0042"]["studies"]["gauge_linearity"][-1]
+    assert entry["result"] == "not acceptable" and entry["port"] == {
+        "url": simulator,
+        "device": "1",
+    }
+
+
 @pytest.mark.parametrize(
     "simulator",
     [("--model", "joints", "--faulty-joint", "3", "--joint-fault", "noise", "--seed", "4")],

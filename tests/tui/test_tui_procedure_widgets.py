@@ -66,3 +66,10 @@ def test_the_count_field_follows_the_procedure() -> None:
     assert "25 to 30" in cycles.hint
     # The linear scale measures the position along the bar: it takes no limits.
     assert judged_channels(linearity) == ["h", "v"]
+    # A method names its block's placements: the gauge linearity study counts its masters,
+    # and judges no spec limits (its verdict is its own).
+    study = catalog.get("gauge_linearity")
+    masters = count_field(study)
+    assert (masters.label, masters.setup_key, masters.target) == ("Masters", "placements", 5)
+    assert "AIAG asks for 5 or more" in masters.hint
+    assert judged_channels(study) == []

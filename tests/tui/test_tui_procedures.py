@@ -109,7 +109,7 @@ async def test_relative_accuracy_through_the_tui(tmp_path: Path, lab: DemoLab, t
                 await tui.wait_until(
                     pilot, lambda: len(app.screen.query("#step-inputs Input")) == 3
                 )
-                shown = fixture.pendant(step.placement)
+                shown = fixture.simulator.model.placement_of(step.placement)
                 # The pendant display is on screen, and the placement p of P.
                 assert shown.pendant_text() in text_of(app, "#step-text")
                 assert f"placement {step.placement} of 3" in text_of(app, "#step-title")
@@ -164,7 +164,7 @@ async def test_relative_accuracy_through_the_tui(tmp_path: Path, lab: DemoLab, t
     placements = document["accuracy"]["placements"]
     assert [p["placement"] for p in placements] == [1, 2, 3]
     for placement in placements:
-        expected = fixture.pendant(placement["placement"]).pendant
+        expected = fixture.simulator.model.placement_of(placement["placement"]).pendant
         assert placement["pendant"] == dict(zip("xyz", expected, strict=True))
         # The summary's per-placement block shows the same mean errors as the command.
         means = view.report.result.placements[placement["placement"] - 1].mean

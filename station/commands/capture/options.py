@@ -12,7 +12,6 @@ from typing import Any
 from station.commands._args import parse_limit, positive_number
 from station.errors import StationError
 from station.instruments.protocols import get_protocol
-from station.procedures import discover_procedures
 from station.text import parse_channel_map
 
 _SETUP_OPTIONS = (
@@ -50,6 +49,10 @@ def new_setup(args: argparse.Namespace) -> Any:
     ]
     if missing:
         raise StationError(f"{', '.join(missing)} missing: a new session needs them (or --resume)")
+    # Deferred: the methods load numpy (``station --help`` builds this command's parser).
+    import station.methods  # noqa: F401 - procedure files name the methods
+    from station.procedures import discover_procedures
+
     procedure = discover_procedures(args.procedures).get(args.procedure)
     limits = {}
     for text in args.limit:

@@ -85,7 +85,7 @@ class Printer:
             and notice.message.level == "info"
             and notice.state.status == "finished"
         ):
-            # What the analysis kind did with the finished session (a gauge check filed).
+            # What the method did with the finished session (a gauge check filed).
             self._print(notice.message.text)
         elif notice.message is not None and notice.message.level == "warning":
             # Errors are not printed here: each one also ends the command with its own line.
@@ -164,7 +164,7 @@ def acknowledge_at_terminal(
 def print_summary(runner: Any, analysis: Any) -> None:
     """The session's report as ``station analyze FILE`` prints it (through the analysis-kind
     registry, so a site's own procedure of a kind gets that kind's report)."""
-    from station.verdicts import analyze_session_file
+    from station.methods import analyze_session_file
 
     report, problem = None, None
     try:

@@ -6,7 +6,6 @@ from typing import TYPE_CHECKING
 
 from station.procedures import StepSchema
 from station.run.state import Action
-from station.run.steps import register
 from station.run.steps.base import PlanItem, StepHandler
 
 if TYPE_CHECKING:
@@ -24,6 +23,3 @@ class CheckStep(StepHandler):
 
     def confirm(self, run: Runner, item: PlanItem, by: str) -> None:
         run.complete_step(item, by)
-
-
-register(CheckStep())

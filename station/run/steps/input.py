@@ -9,7 +9,6 @@ from typing import TYPE_CHECKING, Any
 from station.errors import StationError
 from station.procedures import StepSchema
 from station.run.state import Action
-from station.run.steps import register
 from station.run.steps.base import PlanItem, StepHandler
 
 if TYPE_CHECKING:
@@ -63,6 +62,3 @@ class InputStep(StepHandler):
                 recorded[name] = text
         run.append("input", step=item.step.id, placement=item.placement, values=recorded, by=by)
         run.complete_step(item, by)
-
-
-register(InputStep())

@@ -8,7 +8,6 @@ from collections.abc import Iterable
 from typing import TYPE_CHECKING
 
 from station.procedures import Step, StepSchema
-from station.run.steps import register
 from station.run.steps.base import PlanItem, StepHandler
 
 if TYPE_CHECKING:
@@ -20,7 +19,7 @@ class RepeatBlock(StepHandler):
     """Unrolls into its inner steps, ``placements`` (the set-up's) or its target times."""
 
     kind = "repeat"
-    schema = StepSchema(block=True, implies_analysis="relative_accuracy")
+    schema = StepSchema(block=True)
 
     def unroll(self, step: Step, placements: int | None) -> Iterable[PlanItem]:
         count = int(placements or step.count_target or 1)
@@ -30,6 +29,3 @@ class RepeatBlock(StepHandler):
 
     def action(self, run: Runner, item: PlanItem) -> Action:
         raise AssertionError("a repeat block is unrolled; it is never the current step")
-
-
-register(RepeatBlock())

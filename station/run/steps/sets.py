@@ -14,7 +14,6 @@ from typing import TYPE_CHECKING, Any
 from station.errors import StationError
 from station.procedures import StepSchema
 from station.run.state import Action, CycleOutcome, Progress
-from station.run.steps import register
 from station.run.steps.base import PlanItem, StepHandler
 
 if TYPE_CHECKING:
@@ -141,7 +140,3 @@ class CyclesStep(SetStep):
         target, _ = self.counts(run, item)
         if run.accepted_in(item) == target:
             run.say("info", f"All {target} cycles are recorded: go on, or finish.")
-
-
-register(CaptureStep())
-register(CyclesStep())

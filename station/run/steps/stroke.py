@@ -20,7 +20,6 @@ from station.analysis.strokes import TravelTracker, stroke_deadband
 from station.errors import StationError
 from station.procedures import Step, StepSchema
 from station.run.state import Action, Progress, StrokeOutcome
-from station.run.steps import register
 from station.run.steps.base import PlanItem, StepHandler
 
 if TYPE_CHECKING:
@@ -42,7 +41,7 @@ class StrokeStep(StepHandler):
     """Done by the operator's confirm once its minimum of whole strokes is streamed."""
 
     kind = "stroke"
-    schema = StepSchema(channels=True, counts=True, direction=True, implies_analysis="linearity")
+    schema = StepSchema(channels=True, counts=True, direction=True)
 
     def header_fields(self, setup: SessionSetup, step: Step) -> Mapping[str, Any]:
         return {
@@ -271,6 +270,3 @@ class StrokeStep(StepHandler):
                 by=by,
                 end=True if end else None,
             )
-
-
-register(StrokeStep())

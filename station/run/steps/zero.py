@@ -9,7 +9,6 @@ from station.errors import StationError
 from station.instruments.zeroing import DEFAULT_ZERO_SETTLE, DEFAULT_ZERO_STILL
 from station.procedures import StepSchema
 from station.run.state import Action
-from station.run.steps import register
 from station.run.steps.base import PlanItem, StepHandler
 
 if TYPE_CHECKING:
@@ -108,6 +107,3 @@ class ZeroStep(StepHandler):
             )
             run.zero_recorded(event)
             run.complete_step(item, by)
-
-
-register(ZeroStep())

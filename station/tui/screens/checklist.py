@@ -144,18 +144,18 @@ class ChecklistScreen(Screen[None]):
         )
         text = shown(" ".join(step.text.split()))
         asks = todo.kind if todo is not None else "confirm"
-        pendant = self._demo_pendant(view) if asks == "input" else None
-        if pendant is not None:
-            text.append("\n\nTeach pendant (simulated): ", style="bold")
-            text.append(shown_line(pendant), style="bold reverse")
+        display = self._demo_display(view) if asks == "input" else None
+        if display is not None:
+            text.append(f"\n\n{display.label}: ", style="bold")
+            text.append(shown_line(display.text), style="bold reverse")
         self.query_one("#step-text", Static).update(text)
         action = ENTER_DOES.get(asks, "Press Enter to continue.")
         runner = self.app.runner
         if asks == "zero" and runner is not None and runner.setup.trigger == "arrival":
             action = ARRIVAL_ZERO_DOES
-        if self.app.config.demo is not None and asks == "input":
-            action += " (Demo: copy the simulated pendant's X, Y, Z shown above.)"
-        elif self.app.config.demo is not None:
+        if display is not None:
+            action += f" (Demo: {display.hint}.)"
+        elif self.app.config.demo is not None and asks != "input":
             action += " (Demo: the robot and the gauges are simulated; just press Enter.)"
         self.query_one("#step-action", Static).update(Text(action, style="bold cyan"))
         if todo is not None and todo.kind == "input":
@@ -173,14 +173,13 @@ class ChecklistScreen(Screen[None]):
                 inputs.mount(row)
             self.call_after_refresh(self._focus_first_input)
 
-    def _demo_pendant(self, view: StepView) -> str | None:
-        """What the demo's simulated pendant shows at this placement (None off the demo)."""
+    def _demo_display(self, view: StepView) -> Any:
+        """What the demo's simulated set-up shows at this step's placement (the teach
+        pendant's X, Y, Z; a master's size), or None off the demo."""
         fixture = self.app.demo_fixture
-        placement = fixture.pendant(view.placement) if fixture is not None else None
-        if placement is None:
+        if fixture is None:
             return None
-        unit = str(self.app.session_header.get("unit") or "in")
-        return str(placement.pendant_text(unit))
+        return fixture.shows(view.placement, str(self.app.session_header.get("unit") or "in"))
 
     def on_descendant_focus(self, event: events.DescendantFocus) -> None:
         """Mark the focused field's row (its label in reverse video)."""

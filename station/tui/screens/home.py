@@ -19,7 +19,6 @@ from textual.widgets.option_list import Option
 
 from station.errors import StationError
 from station.session.store import find_unfinished, list_sessions
-from station.tui.instruments import DEMO_PROCEDURES
 from station.tui.remedies import explained
 from station.tui.screens.dialogs import HelpScreen
 from station.tui.text import shown, shown_line
@@ -93,10 +92,14 @@ class HomeScreen(Screen[None]):
             Option("New session (choose the procedure, robot, limits and port)", id="new")
         )
         if config.demo_lab is not None:
-            for procedure, setup in DEMO_PROCEDURES.items():
-                if procedure != config.demo.procedure:  # type: ignore[union-attr]
-                    label = f"Demo {procedure.replace('_', ' ')} instead ({setup})"
-                    choices.add_option(Option(label, id=f"demo:{procedure}"))
+            from station.tui.instruments import demo_methods  # deferred: the methods load numpy
+
+            catalog = self.app.catalog
+            for method, setup in demo_methods().items():
+                # The built-in procedure of each simulated method (they share its name).
+                if method != config.demo.procedure and catalog.is_builtin(method):  # type: ignore[union-attr]
+                    label = f"Demo {method.replace('_', ' ')} instead ({setup})"
+                    choices.add_option(Option(label, id=f"demo:{method}"))
         choices.add_option(Option(f"Review saved sessions ({self._session_count})", id="review"))
         choices.add_option(Option("Quit", id="quit"))
         choices.highlighted = 0

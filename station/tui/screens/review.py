@@ -20,7 +20,6 @@ from textual.widgets import DataTable, Footer, Static
 
 from station.errors import StationError
 from station.session.store import list_sessions, status_words
-from station.text import overall_judgement
 from station.tui.remedies import explained
 from station.tui.screens.dialogs import HelpScreen, TextPrompt
 from station.tui.screens.summary import SummaryScreen, SummaryView
@@ -133,11 +132,9 @@ class ReviewScreen(Screen[None]):
 
         for path in paths:
             try:
-                view = SummaryView.from_file(path)
-                channels = getattr(view.analysis, "channels", {}) or {}
                 # The summary's own judgement, its first word in the narrow column (a session
                 # below the minimum count is PROVISIONAL here too, never CAPABLE).
-                word = overall_judgement(channels.values()).partition(":")[0]
+                word = SummaryView.from_file(path).verdict_word
             except (StationError, OSError, ValueError, AttributeError):
                 word = "—"
             self.app.call_from_thread(self._show_verdict, path, word)

@@ -91,7 +91,11 @@ class SetupScreen(ConnectionTestScreen):
             self.procedure_id = self._header.get("procedure", {}).get("id", self.procedure_id)
         if self.procedure_id is None:
             ids = catalog.ids()
-            self.procedure_id = "repeatability" if "repeatability" in ids else ids[0]
+            # The default method's own procedure (they share its name), else the first.
+            from station.methods import names  # loaded with the catalog
+
+            default = names()[0]
+            self.procedure_id = default if default in ids else ids[0]
         procedure = catalog.get(self.procedure_id)
         self.procedure_id = procedure.id
         # In the demo each procedure has its own simulated set-up (and port).

@@ -1,6 +1,6 @@
 """The set-up form's rows and defaults: which fields a procedure's set-up has, what they are
 filled with (a resumed file's record, the demo's simulated line, the last set-up remembered),
-and the count field (cycles, placements or strokes) its analysis asks for.
+and the count field (cycles, placements or strokes) its method asks for.
 
 Nothing here reads what was typed (``setup_checks``) or talks to the gauges
 (``setup_connection``); :class:`~station.tui.screens.setup.SetupScreen` puts the rows in its
@@ -23,12 +23,12 @@ from textual.widgets import Input, Label, Select, Static
 from station.instruments.protocols import protocol_names
 from station.instruments.transport import list_ports
 from station.plain import plain
-from station.procedures import analysis_needs
 from station.session.model import load_session
 from station.text import LIMIT_HELP, channel_map_text, limits_text
 from station.tui.text import shown
 
 if TYPE_CHECKING:
+    from station.methods.contract import CountField
     from station.procedures import Procedure
     from station.tui.app import DemoPort
 
@@ -44,11 +44,6 @@ DEMO_LIMITS = "±0.001"
 DEMO_TRIAL_MINIMUM = 2
 """The fewest cycles, placements or strokes a demo's trial run may ask for."""
 KEPT_ON_PROCEDURE_CHANGE = ("robot", "operator", "port", "protocol", "map", "trigger")
-STROKE_LIMITS_HELP = (
-    "Strokes: the limits about the bar's line make a straightness tolerance of USL − LSL "
-    "(±0.001 → 0.002); each stroke's straightness (never below 0) is judged one-sided "
-    "against it: Cpk = (tolerance − X̄)/3σ, Cp is not defined."
-)
 
 SelectMaker = Callable[..., Select]
 """Makes a drop-down: ``(field_id, options, value, **options)`` (the screen keeps its value)."""
@@ -160,10 +155,11 @@ def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
             f"limits-{channel}",
         )
     yield Static(LIMIT_HELP, classes="field-hint")
-    if any(step.kind == "stroke" for step in procedure.steps):
-        # Streamed strokes are judged by their straightness, not by these limits
-        # directly: say how, here, and not only in the procedure file.
-        yield Static(STROKE_LIMITS_HELP, classes="field-hint")
+    limits_help = _method(procedure).limits_help
+    if limits_help:
+        # How the method judges these limits (linearity: by each stroke's straightness), said
+        # here and not only in the procedure file.
+        yield Static(limits_help, classes="field-hint")
     yield from field_row(
         count.label,
         Input(
@@ -233,77 +229,22 @@ def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
     )
 
 
-@dataclass(frozen=True)
-class CountField:
-    """What the set-up's count field asks for: cycles (repeatability), placements (a
-    ``repeat`` block, relative accuracy) or strokes (a ``stroke`` step, linearity)."""
+def _method(procedure: Procedure) -> Any:
+    """The method that judges ``procedure``'s sessions."""
+    from station.methods import method_of  # deferred: the methods load numpy
 
-    label: str
-    noun: str
-    setup_key: str
-    """The ``SessionSetup`` argument it fills: ``cycles``, ``placements`` or ``strokes``."""
-    header_key: str
-    target: int
-    minimum: int
-    hint: str
-    too_few: str
+    return method_of(procedure.analysis)
 
 
 def count_field(procedure: Procedure) -> CountField:
-    """The count field of ``procedure``'s set-up (see :class:`CountField`)."""
-    steps = list(procedure.steps)
-    stroke = next((s for s in steps if s.kind == "stroke"), None)
-    repeat = next((s for s in steps if s.kind == "repeat"), None)
-    if stroke is not None:
-        target = int(stroke.count_target or procedure.cycles_target)
-        low = int(stroke.count_min or target)
-        # Fewer strokes are allowed (a short trial run); the report's range is said.
-        return CountField(
-            "Strokes",
-            "strokes",
-            "strokes",
-            "strokes_target",
-            target,
-            2,
-            f"A↔B strokes; the report asks for {low} to {target}",
-            f"Give at least 2 strokes (one each way); the report asks for {low} to {target}.",
-        )
-    if repeat is not None:
-        target = int(repeat.count_target or 1)
-        low = int(repeat.count_min or target)
-        return CountField(
-            "Placements",
-            "placements",
-            "placements",
-            "placements_target",
-            target,
-            1,
-            f"fixture placements over the envelope; the report asks for a few ({low} to {target})",
-            "Give at least 1 fixture placement.",
-        )
-    # Fewer cycles are allowed (a short trial run, e.g. the demo's --count 5): the verdict says
-    # it is provisional below the report's minimum.
-    return CountField(
-        "Cycles",
-        "cycles",
-        "cycles",
-        "cycles_target",
-        procedure.cycles_target,
-        2,
-        f"the report asks for {procedure.cycles_min} to {procedure.cycles_target}",
-        f"Give at least 2 cycles; the report asks for {procedure.cycles_min} to "
-        f"{procedure.cycles_target}.",
-    )
+    """What ``procedure``'s set-up counts (cycles, its block's placements, strokes), in its
+    method's words."""
+    return _method(procedure).count_field(procedure)  # type: ignore[no-any-return]
 
 
 def judged_channels(procedure: Procedure) -> list[str]:
-    """The channels that take limits: all but a stroke step's position channel (the linear
-    scale measures where along the bar, not an error); none when the procedure's analysis
-    kind judges no spec limits (a gauge check, a gain schedule)."""
-    if not analysis_needs(procedure.analysis).limits:
-        return []
-    positions = {s.direction_channel for s in procedure.steps if s.kind == "stroke"}
-    return [c for c in procedure.channels if c not in positions]
+    """The channels that take limits (none when the method judges no spec limits)."""
+    return list(_method(procedure).judged_channels(procedure))
 
 
 def login_name() -> str:

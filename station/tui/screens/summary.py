@@ -61,9 +61,9 @@ class SummaryView:
     excluded_cycles: tuple[int, ...] = ()
     notes: tuple[str, ...] = field(default_factory=tuple)
     report: Any = None
-    """A linearity or relative-accuracy session's own analysis and report block
-    (``station.verdicts.SessionReport``): its ``analysis`` is then what the verdict
-    judges."""
+    """The session's report by its method (``station.methods.SessionReport``): its
+    ``analysis`` is what the capability verdict judges, its ``verdict`` the method's own (a
+    gauge study's), its blocks the method's report."""
 
     @classmethod
     def from_live(cls, state: RunnerState, analysis: Any, header: Mapping[str, Any]) -> SummaryView:
@@ -72,7 +72,8 @@ class SummaryView:
         return cls(
             path=state.path,
             header=dict(header),
-            analysis=report.analysis if report is not None and report.analysis else analysis,
+            # The method's judgement of the file; the live analysis only when there is none.
+            analysis=report.analysis if report is not None and not report.empty else analysis,
             last_hash=state.last_hash,
             status=state.status,
             cycle_numbers=tuple(r.cycle for r in state.cycles if r.rejected is None),
@@ -103,6 +104,16 @@ class SummaryView:
         )
 
     @property
+    def verdict_word(self) -> str:
+        """The verdict's first word as a list shows it: the method's own (ACCEPTABLE), else
+        the overall capability judgement (PROVISIONAL below the minimum count)."""
+        own = getattr(self.report, "verdict", None)
+        if own is not None:
+            return str(own.word)
+        channels = getattr(self.analysis, "channels", {}) or {}
+        return overall_judgement(channels.values()).partition(":")[0]
+
+    @property
     def unit(self) -> str:
         """The session's unit."""
         return str(self.header.get("unit", ""))
@@ -121,11 +132,11 @@ REPORT_WIDTH = 74
 def _procedure_report(
     path: Path, header: Mapping[str, Any], session: Any = None
 ) -> tuple[Any, tuple[str, ...]]:
-    """The session's report as its analysis kind makes it (through the registry: the verdict,
-    and for kinds with a report block of their own, that block), and a note saying why there
-    is none when the file has nothing to analyse yet. ``session``: the file already loaded."""
-    # Deferred: the analysis kinds load numpy (on a worker while the screens before it show).
-    from station.verdicts import load_session_source, report_session, session_source
+    """The session's report as its method makes it (the verdict, and for methods with a report
+    block of their own, that block), and a note saying why there is none when the file has
+    nothing to analyse yet. ``session``: the file already loaded."""
+    # Deferred: the methods load numpy (on a worker while the screens before it show).
+    from station.methods import load_session_source, report_session, session_source
 
     try:
         source = load_session_source(path) if session is None else session_source(session)
@@ -166,6 +177,13 @@ def verdict_text(view: SummaryView) -> Text:
     readings out of specification."""
     analysis = view.analysis
     text = Text()
+    own = getattr(view.report, "verdict", None)
+    if analysis is None and own is not None:
+        # A method with a verdict of its own (a gauge linearity study): its word and why.
+        text.append("Verdict: ", style="bold")
+        text.append(own.word, style=VERDICT_STYLES.get(own.word, ""))
+        text.append(f"\n  {shown_line(own.sentence, limit=None)}\n")
+        return text
     if analysis is None and view.report is not None and not view.report.empty:
         # A kind that judges no readings (a gain schedule): its report block is the result.
         return Text("No capability verdict: this procedure judges no readings (its report below).")

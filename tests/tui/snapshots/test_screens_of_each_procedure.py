@@ -105,7 +105,7 @@ async def _until_action(pilot, tui, kind: str) -> None:
         await tui.wait_until(pilot, lambda: not app.screen.busy)
         if state.action.kind == "input":
             await tui.wait_until(pilot, lambda: len(app.screen.query("#step-inputs Input")) == 3)
-            pendant = app.demo_fixture.pendant(state.current.placement).pendant
+            pendant = app.demo_fixture.simulator.model.placement_of(state.current.placement).pendant
             for axis, value in zip("xyz", pendant, strict=True):
                 app.screen.query_one(f"#input-{axis}", Input).value = str(value)
             app.screen.query_one("#input-z", Input).focus()

@@ -1,5 +1,6 @@
-"""The live analyses the engine feeds while a session runs: :class:`LiveCycles` (repeatability,
-relative accuracy: O(1) per cycle) and :class:`LiveStrokes` (linearity: each whole stroke)."""
+"""The live analysis of cycles the engine feeds while a session runs (:class:`LiveCycles`:
+O(1) per cycle), the one most methods take; a method with another (linearity's strokes) keeps
+its own in its package."""
 
 from __future__ import annotations
 
@@ -7,17 +8,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
-import numpy as np
-
-from station.analysis.linearity import analyze_linearity, linearity_summary, tolerance_from_limits
 from station.analysis.live import LiveAnalysis, LiveReadings
 from station.analysis.monitor import LiveMonitor, Rejection
-from station.analysis.strokes import StrokeProfile
 from station.analysis.summary import Analysis, AnalysisConfig
-from station.errors import StationError
 from station.session.alarms import live_events
 from station.session.model import Session
-from station.verdicts.sessions import marked_profiles, session_stroke_profiles
 
 
 class LiveCycles:
@@ -54,8 +49,14 @@ class LiveCycles:
         return self._live if self._monitor is None else self._monitor.live
 
     def add_cycle(
-        self, values: Mapping[str, float], cycle: int, times: Mapping[str, float] | None = None
+        self,
+        values: Mapping[str, float],
+        cycle: int,
+        times: Mapping[str, float] | None = None,
+        placement: int | None = None,
     ) -> Mapping[str, Any]:
+        """Take one accepted cycle (the placement it was taken at is not this analysis'
+        business); per channel an update whose ``alarms`` are new."""
         if self._monitor is None:
             return self._live.add_set(values, cycle, times)
         updates, new = self._monitor.add_set(values, cycle, times)
@@ -95,8 +96,8 @@ class LiveCycles:
                     self._monitor.reject(number)
             fresh._monitor = self._monitor
             return fresh
-        for values, number, *times in cycles:
-            fresh.add_cycle(values, number, times[0] if times else None)
+        for values, number, *rest in cycles:
+            fresh.add_cycle(values, number, rest[0] if rest else None)
         return fresh
 
 
@@ -113,85 +114,3 @@ class CyclesSoFar:
     def result(self) -> None:
         """A kind of cycles has no result of its own."""
         return None
-
-
-@dataclass(frozen=True)
-class StrokesSoFar:
-    """The live result of a linearity session: the analysis of the whole strokes so far and
-    their profiles (for the deviation plots)."""
-
-    analysis: Any
-    profiles: tuple[StrokeProfile, ...]
-
-
-class LiveStrokes:
-    """The live analysis of streamed strokes (linearity): each whole stroke the engine split
-    is judged as the batch analysis judges it (the same profiles, the same function)."""
-
-    def __init__(
-        self, config: AnalysisConfig, channels: Sequence[str], header: Mapping[str, Any]
-    ) -> None:
-        self.config, self.channels, self.header = config, tuple(channels), header
-        self.profiles: list[StrokeProfile] = []
-        self._result: Any = None
-
-    def add_cycle(
-        self, values: Mapping[str, float], cycle: int, times: Mapping[str, float] | None = None
-    ) -> Mapping[str, Any]:
-        return {}
-
-    def add_stroke(self, outcome: Any) -> None:
-        profile = {
-            name: np.asarray(values, dtype=float) for name, values in outcome.profile.items()
-        }
-        if "s" not in profile:
-            return
-        numbers = np.full(len(profile["s"]), len(self.profiles) + 1)
-        others = {name: values for name, values in profile.items() if name != "s"}
-        added = marked_profiles(numbers, profile["s"], others, self.header.get("deadband"))
-        for found in added:
-            self.profiles.append(
-                StrokeProfile(
-                    number=len(self.profiles) + 1,
-                    direction=outcome.direction or found.direction,
-                    s=found.s,
-                    channels=found.channels,
-                    recorded=outcome.stroke,
-                )
-            )
-        self._result = None
-
-    def result(self) -> StrokesSoFar | None:
-        if not self.profiles:
-            return None
-        if self._result is None:
-            self._result = StrokesSoFar(
-                analyze_linearity(
-                    self.profiles, tolerance=tolerance_from_limits(self.config), config=self.config
-                ),
-                tuple(self.profiles),
-            )
-        return self._result
-
-    def snapshot(self) -> Analysis:
-        result = self.result()
-        if result is None:
-            raise StationError("no whole stroke yet: stream one first.")
-        return linearity_summary(result.analysis)
-
-    def copy(self) -> LiveStrokes:
-        kept = type(self)(self.config, self.channels, self.header)
-        kept.profiles = list(self.profiles)
-        kept._result = self._result
-        return kept
-
-    def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveStrokes:
-        fresh = type(self)(self.config, self.channels, self.header)
-        if session is None:
-            fresh.profiles = list(self.profiles)
-        else:
-            try:
-                fresh.profiles = list(session_stroke_profiles(session))
-            except StationError:
-                fresh.profiles = []  # no whole stroke yet
-        return fresh
