@@ -11,7 +11,7 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 
-LEAVES_AND_LOOKS = """
+LEAVES_AND_LOOKS = r"""
 import os
 from pathlib import Path
 

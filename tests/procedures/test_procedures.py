@@ -345,6 +345,7 @@ def test_the_analysis_kind_defaults_by_step_kinds(tmp_path: Path) -> None:
         "relative_accuracy": "relative_accuracy",
         "linearity": "linearity",
         "gauge_check": "gauge_check",
+        "gauge_linearity": "gauge_linearity",
         "joint_troubleshooting": "joint_troubleshooting",
         "gain_schedule": "gain_schedule",
     }

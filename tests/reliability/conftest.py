@@ -56,6 +56,10 @@ class Capture:
 
     def __init__(self, args: list[str], preexec_fn: Callable[[], None] | None = None) -> None:
         env = {**os.environ, "PYTHONUNBUFFERED": "1", "STATION_PROCEDURES": ""}
+        if preexec_fn is not None:
+            # A child under a resource limit (a file-size cap) could not write its coverage
+            # data at exit, and coverage's traceback would land among the lines under test.
+            env.pop("COVERAGE_PROCESS_CONFIG", None)
         self.process = subprocess.Popen(
             [sys.executable, "-m", "station", "capture", *args],
             stdout=subprocess.PIPE,
