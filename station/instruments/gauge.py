@@ -24,6 +24,7 @@ from station.instruments.arrival import ArrivalConfig, ArrivalDetector, ArrivalE
 from station.instruments.base import Protocol, Rejection, SerialSettings
 from station.instruments.capture import CaptureResult, SetCaptures
 from station.instruments.frame_check import SetFrameChecks
+from station.instruments.motion import default_free_travel
 from station.instruments.reader import (
     DEFAULT_BACKOFF,
     GaugeReader,
@@ -157,6 +158,7 @@ class GaugeSet(SetCaptures, SetZeroing, SetFrameChecks):
             settle=config.settle,
             side=config.stop,
             free_travel=config.free_travel,
+            depth=abs(default_free_travel(unit)) / 2,
         )
         """Where each plunger rests with nothing touching it (stated, or learned from the
         robot's motion), so that no zero and no set is taken with the robot away."""

@@ -14,8 +14,10 @@ that was never measured. :class:`TravelWatch` tells the two apart from the motio
   plunger's free end, so the reading farthest toward it seen around such a trip is the
   **stop**: the lower end by default (a plunger pushed in reads higher, as on the report's
   indicators), the higher with ``side = "high"`` (an indicator that counts the other way).
-  The robot need not wait at the stop for it to be seen. A procedure may also state each
-  stop's reading (its ``free_travel``), and then nothing needs learning;
+  The robot need not wait at the stop for it to be seen. A move of less than ``depth`` (half
+  the cube's deflection, by default) is the cube shifting in the fixture, or a fixture placed
+  again with another preload, not the robot leaving: nothing is learned from it. A procedure
+  may also state each stop's reading (its ``free_travel``), and then nothing needs learning;
 * the robot is **at the fixture** when every channel rests more than the band away from its
   stop, on the side the cube pushes the plunger to.
 
@@ -139,7 +141,8 @@ class TravelWatch:
 
     ``band`` is the half-width of the working band per channel (the arrival trigger's);
     ``still`` (resolutions) and ``settle`` (seconds) say what a rest is; ``free_travel`` states
-    stops (device readings per channel) where they are known.
+    stops (device readings per channel) where they are known; ``depth``: a stop is learned
+    only from a rest reached from more than this (and more than the band) toward the free end.
     """
 
     def __init__(
@@ -151,6 +154,7 @@ class TravelWatch:
         settle: float,
         side: StopSide = "low",
         free_travel: Mapping[str, float] | None = None,
+        depth: float = 0.0,
     ) -> None:
         if side not in STOP_SIDES:
             raise StationError(
@@ -159,6 +163,7 @@ class TravelWatch:
         self.side: StopSide = side
         self.still = still
         self.settle = settle
+        self.depth = float(depth)
         stated = dict(free_travel or {})
         self._tracks = {
             channel: _Track(float(res), float(band[channel]), stated.get(channel), self._window())
@@ -198,10 +203,10 @@ class TravelWatch:
         if not seen:
             return
         free = self._free_most(*seen)
-        if self._pressed(level, free, track.band):
-            # The channel came to rest from more than the band toward the free end: an
-            # arrival. Nothing reads beyond the stop, so the farthest free reading seen is
-            # (as far as is known) the stop.
+        if self._pressed(level, free, max(track.band, self.depth)):
+            # The channel came to rest from more than the band and the depth toward the free
+            # end: an arrival. Nothing reads beyond the stop, so the farthest free reading
+            # seen is (as far as is known) the stop.
             known = track.learned_stop
             track.learned_stop = free if known is None else self._free_most(known, free)
 

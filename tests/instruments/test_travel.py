@@ -175,3 +175,23 @@ def test_the_sliding_window_agrees_with_a_plain_recount(steps) -> None:
         assert window.mean() == pytest.approx(sum(values) / len(values), abs=1e-12)
         gaps = [b[0] - a[0] for a, b in zip(kept, kept[1:], strict=False)]
         assert window.gapless() == all(gap <= 0.2 + 1e-9 for gap in gaps)
+
+
+def test_a_fixture_placed_again_with_another_preload_teaches_no_stop() -> None:
+    """Two fixtures placed five times: each placement's cube presses the plungers a few
+    hundredths deeper or shallower (more than the band) with no trip to the stop between. The
+    CI's demo learned a "stop" from such a shift and refused the fifth placement's zero; less
+    than half the cube's deflection is no round trip."""
+    travel = watch(depth=0.375 / 2)
+    t = 0.0
+    for preload in (0.03, -0.04, 0.02, 0.045, -0.038):
+        for _ in range(10):
+            travel.feed("y", preload, t)
+            t = round(t + POLL, 6)
+    assert travel.stops() == {}
+    assert travel.at_stop({"y": -0.038}) == ()
+    # A real round trip, to the stop and back, is still learned.
+    for value in (FREE,) * 10 + (-0.038,) * 10:
+        travel.feed("y", value, t)
+        t = round(t + POLL, 6)
+    assert travel.stops() == pytest.approx({"y": FREE})
