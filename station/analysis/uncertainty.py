@@ -51,6 +51,10 @@ how certificates state it); :func:`from_half_width` takes another ``k``."""
 DEFAULT_K = 2.0
 """The coverage factor when neither a k nor a confidence is given (about 95 % on ν_eff = ∞)."""
 
+MAGNITUDE = 1e150
+"""The largest contribution |c|·u taken (the station's bound on readings and limits): U and the
+guard bands stay finite."""
+
 STEEL_EXPANSION = 11.5e-6
 """Linear expansion coefficient of steel per °C, for :func:`temperature` (the reference's α)."""
 
@@ -84,6 +88,12 @@ class Contribution:
         if not self.dof >= 1:
             raise StationError(
                 f"input {self.name!r}: dof must be 1 or more (or inf), not {self.dof!r}."
+            )
+
+        if not abs(self.sensitivity) * self.u <= MAGNITUDE:
+            raise StationError(
+                f"input {self.name!r}: |sensitivity| × u is beyond {MAGNITUDE:g}; check the "
+                "unit of both."
             )
 
     @property
@@ -267,26 +277,40 @@ def evaluate(
         budget = Budget(tuple(budget))
     if k is not None and confidence is not None:
         raise StationError("give a coverage factor k or a confidence, not both.")
-    squares = [c.ui**2 for c in budget.contributions]
-    variance = math.fsum(squares)
-    u_c = math.sqrt(variance)
+    shares = _relative_squares(budget.contributions)
+    largest = max(c.ui for c in budget.contributions)
+    u_c = largest * math.sqrt(math.fsum(shares))
     nu_eff = welch_satterthwaite(budget.contributions)
     if confidence is not None:
         coverage = coverage_factor(check_confidence(confidence), nu_eff)
     else:
         coverage = check_coverage(DEFAULT_K if k is None else k)
+    total = math.fsum(shares)
     lines = tuple(
-        Line(c.name, c.u, c.sensitivity, c.ui, float(c.dof), square / variance if variance else 0.0)
-        for c, square in zip(budget.contributions, squares, strict=True)
+        Line(c.name, c.u, c.sensitivity, c.ui, float(c.dof), share / total if total else 0.0)
+        for c, share in zip(budget.contributions, shares, strict=True)
     )
     return BudgetResult(u_c, nu_eff, coverage, coverage * u_c, confidence, lines, budget.unit)
+
+
+def _relative_squares(contributions: Sequence[Contribution]) -> list[float]:
+    # (c_i u_i / max c u)²: the sums below are scale-free, so taking them relative to the largest
+    # line keeps a budget in nanometres from underflowing its fourth powers (and one in
+    # micro-inches written in metres from overflowing them).
+    largest = max((c.ui for c in contributions), default=0.0)
+    if largest == 0:
+        return [0.0 for _ in contributions]
+    return [(c.ui / largest) ** 2 for c in contributions]
 
 
 def welch_satterthwaite(contributions: Iterable[Contribution]) -> float:
     """ν_eff = u_c⁴ / Σ (c_i u_i)⁴/ν_i; ∞ when every line with a share has ν = ∞ (or u_c = 0)."""
     items = list(contributions)
-    variance = math.fsum(c.ui**2 for c in items)
-    denominator = math.fsum(c.ui**4 / c.dof for c in items if math.isfinite(c.dof))
+    squares = _relative_squares(items)
+    variance = math.fsum(squares)
+    denominator = math.fsum(
+        square**2 / c.dof for c, square in zip(items, squares, strict=True) if math.isfinite(c.dof)
+    )
     if denominator == 0 or variance == 0:
         return math.inf
     return variance**2 / denominator

@@ -93,6 +93,16 @@ def test_nu_eff_truncates_not_rounds():
     assert evaluate(lines, confidence=0.95).k == pytest.approx(2.2622, abs=1e-4)  # t(0.975, 9)
 
 
+def test_tiny_and_large_budgets_keep_their_dof():
+    # Fourth powers of 1e-200 underflow to 0 and would make ν_eff infinite; the sums are taken
+    # relative to the largest line. Two equal lines, one on ν = 4: ν_eff = (2u²)²/(u⁴/4) = 16.
+    for scale in (1e-200, 1.0, 1e140):
+        result = evaluate([Contribution("a", scale, dof=4), Contribution("b", scale)])
+        assert result.nu_eff == pytest.approx(16)
+        assert result.u_c == pytest.approx(scale * math.sqrt(2))
+        assert [line.share for line in result.lines] == pytest.approx([0.5, 0.5])
+
+
 def test_the_lines_of_a_dial_indicator_channel():
     assert resolution(0.0001).u == pytest.approx(0.0001 / math.sqrt(12))  # 2.9e-5 in
     # 10 in of steel, ±1 °C: 1.15e-4 in rectangular, u = 6.6e-5 in (the reference's figure).
@@ -128,6 +138,7 @@ def test_zero_uncertainty_is_allowed_and_has_no_share():
         ),
         (lambda: Contribution("cal", 1.0, sensitivity=math.inf), "sensitivity must be a finite"),
         (lambda: Contribution("cal", 1.0, dof=0.5), "input 'cal': dof must be 1 or more"),
+        (lambda: Contribution("cal", 1e300, sensitivity=1e10), "input 'cal': |sensitivity| × u"),
         (lambda: from_expanded("cal", 1.0, 0), "input 'cal': k must be a finite number above 0"),
         (
             lambda: from_expanded("cal", 1.0, math.inf),
