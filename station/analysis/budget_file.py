@@ -75,6 +75,8 @@ def parse_budget(text: str, source: str = "budget") -> BudgetFile:
         table = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise StationError(f"{source} is not valid TOML ({error}).") from None
+    except RecursionError:
+        raise StationError(f"{source} nests arrays or tables too deeply to read.") from None
     try:
         return _budget_file(table)
     except StationError as error:

@@ -141,6 +141,7 @@ ONE = "[[input]]\nname = 'cal'\n"
         ("k = 0\n" + ONE + "u = 0.1\n", (), "'k' must be a finite number above 0"),
         ("confidence = 95\n" + ONE + "u = 0.1\n", (), "'confidence' must be a probability"),
         ("[[input]\n", (), "is not valid TOML"),
+        ("a = " + "[" * 50_000 + "]" * 50_000 + "\n", (), "nests arrays or tables too deeply"),
         (ONE + "u = 0.1\n", ("--lsl", "1", "--usl", "0"), "the LSL 1 is not below the USL 0"),
         (ONE + "u = 0.1\n", ("--lsl", "1", "--usl", "1"), "the LSL 1 is not below the USL 1"),
         (ONE + "u = 0.1\n", ("--k", "0"), "--k must be a finite number above 0"),
@@ -158,6 +159,14 @@ def test_bad_input_is_refused_in_one_line_naming_it(tmp_path, text, options, wor
     assert done.stderr.count("\n") == 1, done.stderr
     assert done.stderr.startswith("station: ")
     assert words in done.stderr
+
+
+def test_a_file_that_is_not_text_is_one_line(tmp_path):
+    path = tmp_path / "budget.toml"
+    path.write_bytes(b"\xff\xfe[[input]]")
+    done = run_station("budget", path)
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and "is not UTF-8 text" in done.stderr
 
 
 def test_a_missing_file_is_one_line(tmp_path):
