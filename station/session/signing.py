@@ -6,12 +6,14 @@ for finished sessions: the ``finish`` event carries an Ed25519 signature over th
 the ``prev`` hash (which covers every line before it) and its ``seq``, made with a key that only
 this station holds. The header names the key (``signer``: its id and public key), so
 ``station verify`` checks the signature and prints the key id; a rechained or extended forgery
-cannot be re-signed without the private key. (A forger who also replaces the header's public
-key shows a different key id: compare it with the station's, ``station verify`` says whether it
-is this station's key.)
+cannot be re-signed without the private key. A forger who re-signs with a key of their own puts
+that key in the header: ``station verify`` accepts only keys in the trust store
+(:mod:`station.session.trust`). A forger who strips ``signer`` and the signature makes a file
+that looks older than signing: :func:`predates_signing` tells the two apart by the header's date.
 
 The key is made on first use in ``$XDG_CONFIG_HOME/station/signing-key.pem`` (else
-``~/.config/station/``), PKCS#8, mode 0600, in a folder of mode 0700, never through a link.
+``~/.config/station/``), PKCS#8, mode 0600, in a folder of mode 0700, never through a link;
+its public half goes into the trust store when the key is made or first used.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import stat
 import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -35,12 +38,36 @@ from station.errors import StationError
 
 KEY_FILE_NAME = "signing-key.pem"
 SIGNATURE_CONTEXT = b"station-finish/1"
+KEY_ALGORITHM = "ed25519"
+
+SIGNING_SINCE = datetime(2026, 11, 29, tzinfo=UTC)
+"""The day the first version that signs its sessions was made. Every session that version and
+later ones write names its ``signer`` in the header and signs its finish; a header without
+``signer`` is genuine only when it is dated before this (:func:`predates_signing`)."""
 
 
 def config_folder() -> Path:
     """``$XDG_CONFIG_HOME/station`` (``~/.config/station`` when the variable is unset)."""
     base = os.environ.get("XDG_CONFIG_HOME") or str(Path.home() / ".config")
     return Path(base) / "station"
+
+
+def predates_signing(header: Mapping[str, Any]) -> bool:
+    """Whether a header without ``signer`` may be genuine: its ``created`` is a date before
+    :data:`SIGNING_SINCE`, when no station signed yet. A header dated since then, or without a
+    readable date, was written by a signing version, so its missing ``signer`` was removed.
+
+    The date is the file's own word: a forger who also backdates the header passes this rule,
+    which is why ``station verify`` says of every unsigned session that nothing shows who wrote
+    it, and only an anchor on a filed report vouches for it."""
+    created = header.get("created")
+    if not isinstance(created, str):
+        return False
+    try:
+        moment = datetime.fromisoformat(created)
+    except ValueError:
+        return False
+    return moment.tzinfo is not None and moment < SIGNING_SINCE
 
 
 def key_id(public_key: bytes) -> str:
@@ -110,7 +137,30 @@ def station_key(create: bool = True) -> StationKey | None:
         ) from None
     if not isinstance(private, Ed25519PrivateKey):
         raise StationError(f"the station's signing key {path} is not an Ed25519 key")
-    return StationKey(private, _raw_public(private))
+    key = StationKey(private, _raw_public(private))
+    if create:
+        _trust_own_key(key)
+    return key
+
+
+def station_public_key() -> bytes | None:
+    """This station's raw public key, when its private key can be read; None when it is
+    missing, damaged, a link or of another type (``station verify`` then goes by the trust
+    store alone)."""
+    try:
+        key = station_key(create=False)
+    except StationError:
+        return None
+    return key.public_key if key is not None else None
+
+
+def _trust_own_key(key: StationKey) -> None:
+    """Put this station's public key in the trust store (a key made before the store existed
+    is put there on its first use), so ``station verify`` needs no private key."""
+    # Imported here: the trust store builds on this module's key ids.
+    from station.session.trust import trust_own_key
+
+    trust_own_key(key.public_key)
 
 
 def _make_key(path: Path) -> StationKey:
@@ -137,6 +187,7 @@ def _make_key(path: Path) -> StationKey:
         os.close(fd)
         fd = -1
         os.link(draft, path)
+        key = StationKey(private, _raw_public(private))
     except FileExistsError:
         # Another session made it first: use that one.
         key = station_key(create=False)
@@ -151,7 +202,8 @@ def _make_key(path: Path) -> StationKey:
             os.close(fd)
         with contextlib.suppress(OSError):
             os.unlink(draft)
-    return StationKey(private, _raw_public(private))
+    _trust_own_key(key)
+    return key
 
 
 def _raw_public(private: Any) -> bytes:
@@ -172,11 +224,11 @@ class SignatureCheck:
 
 def check_finish_signature(header: Mapping[str, Any], finish: Mapping[str, Any]) -> SignatureCheck:
     """Check ``finish`` (a finish event as stored, with its ``prev`` and ``seq``) against the
-    header's ``signer``. A header without ``signer`` (a session made before signing) is ok
-    with a message saying the finish is unsigned."""
+    header's ``signer``. A header without ``signer`` is not ok here: whether an unsigned session
+    may be genuine is :func:`predates_signing`'s question, asked before this one."""
     signer = header.get("signer")
     if signer is None:
-        return SignatureCheck(True, "", "unsigned (the session predates signing)")
+        return SignatureCheck(False, "", "the session is unsigned")
     try:
         public = base64.b64decode(str(signer["public_key"]), validate=True)
         named = str(signer["key"])

@@ -11,14 +11,17 @@ table, an empty file) is a StationError saying so (exit 2), not a damaged sessio
 
 from __future__ import annotations
 
+import base64
 import os
 import textwrap
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from station.plain import plain
 from station.session.lines import SessionFileError, decode_line, line_hash
 from station.session.model import read_session_bytes, replay_bytes
-from station.session.signing import check_finish_signature, station_key
+from station.session.signing import check_finish_signature, key_id, predates_signing
+from station.session.trust import find_trusted
 
 _WIDTH = 79
 
@@ -38,7 +41,10 @@ class VerifyResult:
     first_bad_line: int | None
     message: str
     key: str = ""
-    """The id of the station key the header names ('' for a session made before signing)."""
+    """The id of the station key the header names ('' for an unsigned session)."""
+    signed_by: str = ""
+    """The key whose signature on the finish holds and how it is trusted ('' when no finish
+    is signed: an unsigned or unfinished session)."""
     remarks: tuple[str, ...] = ()
     """What the verdict does and does not show (the anchor, the signature, this station)."""
     """The verdict after the file's name: ``intact: 6 lines, ...`` or ``NOT intact: line 3:
@@ -56,28 +62,37 @@ class VerifyResult:
             lines += textwrap.wrap(
                 remark, width=_WIDTH, initial_indent="  ", subsequent_indent="  "
             )
-        if self.key:
-            lines.append(f"signed by station key: {self.key}")
+        if self.signed_by:
+            lines.append(f"signed by station key: {self.signed_by}")
         if self.ok:
             lines.append(f"last hash: {self.last_hash}")
         return "\n".join(lines)
 
 
-def verify_session(path: str | os.PathLike[str], anchor: str | None = None) -> VerifyResult:
+def verify_session(
+    path: str | os.PathLike[str],
+    anchor: str | None = None,
+    *,
+    allow_unsigned: bool = False,
+    trust_any: bool = False,
+) -> VerifyResult:
     """Check a session file without changing it.
 
     A missing or unreadable file is a StationError (exit 2); a damaged one is a result with
     ``ok`` False naming the first bad line. With ``anchor`` (the last hash a filed report
     quotes) the file holds only when that is its last line's hash: a file cut short or extended
     since the report fails. A finished session's ``finish`` must carry a valid signature by the
-    key its header names.
+    key its header names, and that key must be in the trust store (:mod:`station.session.trust`)
+    unless ``trust_any``. A header without ``signer`` fails unless it is dated before stations
+    signed (:func:`predates_signing`) or ``allow_unsigned``; the remarks say which allowance
+    let the file pass.
     """
     path = Path(path)
     data = read_session_bytes(path)
     result = _verify_chain(path, data)
     if not result.ok:
         return result
-    return _verify_end(result, data, anchor)
+    return _verify_end(result, data, anchor, allow_unsigned, trust_any)
 
 
 def _verify_chain(path: Path, data: bytes) -> VerifyResult:
@@ -118,32 +133,19 @@ def _verify_chain(path: Path, data: bytes) -> VerifyResult:
     )
 
 
-def _verify_end(result: VerifyResult, data: bytes, anchor: str | None) -> VerifyResult:
-    """The signature of a finished session, the anchor, and what the verdict cannot show."""
+def _verify_end(
+    result: VerifyResult, data: bytes, anchor: str | None, allow_unsigned: bool, trust_any: bool
+) -> VerifyResult:
+    """The signature of a finished session, the trust in its key, the anchor, and what the
+    verdict cannot show."""
     lines = data.split(b"\n")[:-1]
     header = decode_line(lines[0])
     last = decode_line(lines[-1])
-    remarks: list[str] = []
-    key = str((header.get("signer") or {}).get("key") or "")
-    if last.get("type") == "finish":
-        check = check_finish_signature(header, last)
-        if not check.ok:
-            return replace(
-                result,
-                ok=False,
-                first_bad_line=len(lines),
-                message=f"NOT intact: line {len(lines)}: {check.message}",
-                key=key,
-            )
-        if not key:
-            remarks.append(f"The finish is {check.message}.")
-    if key:
-        own = station_key(create=False)
-        if own is not None and own.id != key:
-            remarks.append(
-                f"The header names station key {key}, not this station's key {own.id}: "
-                "compare it with the key of the station that recorded the session."
-            )
+    finished = last.get("type") == "finish"
+    signed = _signature(header, last if finished else None, allow_unsigned, trust_any)
+    if isinstance(signed, _Refusal):
+        return replace(result, ok=False, first_bad_line=signed.line, message=signed.message)
+    key, signed_by, remarks = signed
     if anchor is not None:
         wanted = anchor.strip().lower()
         if wanted != result.last_hash:
@@ -167,6 +169,7 @@ def _verify_end(result: VerifyResult, data: bytes, anchor: str | None) -> Verify
                 first_bad_line=(where + 1) if where is not None else len(lines),
                 message=f"NOT intact: {fault}",
                 key=key,
+                signed_by=signed_by,
             )
         remarks.append("The last line is the anchor: nothing was cut or added since the report.")
     elif result.message.endswith(("running", "interrupted")):
@@ -174,4 +177,81 @@ def _verify_end(result: VerifyResult, data: bytes, anchor: str | None) -> Verify
             "The chain cannot show lines cut from the end (a finished session cut short looks "
             "unfinished): check with --anchor HASH, the last hash on the filed report."
         )
-    return replace(result, key=key, remarks=tuple(remarks))
+    return replace(result, key=key, signed_by=signed_by, remarks=tuple(remarks))
+
+
+@dataclass(frozen=True)
+class _Refusal:
+    message: str
+    line: int | None
+    """The line at fault (None when the file is well formed but no trusted key vouches)."""
+
+
+def _signature(
+    header: dict, finish: dict | None, allow_unsigned: bool, trust_any: bool
+) -> tuple[str, str, list[str]] | _Refusal:
+    """Who vouches for the file: the key id the header names, what the ``signed by`` line says
+    ('' unless a finish is signed) and the remarks; or the verdict when nothing does.
+
+    Exit 0 needs a finish signed by a trusted key, or an unsigned header dated before stations
+    signed (:func:`predates_signing`). An unfinished session has nothing signed yet: its
+    header's key must still be trusted, and the verdict never says it is signed."""
+    signer = header.get("signer")
+    if signer is None:
+        created = plain(header.get("created"), limit=40)
+        if predates_signing(header):
+            return "", "", [_UNSIGNED_OLD.format(created=created)]
+        if allow_unsigned:
+            return "", "", [_UNSIGNED_ALLOWED.format(created=created)]
+        return _Refusal(_UNSIGNED_FORGED.format(created=created), None)
+    if finish is not None:
+        check = check_finish_signature(header, finish)
+        if not check.ok:
+            line = finish["seq"] + 1
+            return _Refusal(f"NOT intact: line {line}: {check.message}", line)
+    try:
+        raw = base64.b64decode(str(signer.get("public_key")), validate=True)
+    except ValueError:
+        return _Refusal("NOT intact: line 1: the header's signer is not an Ed25519 public key", 1)
+    # The id of the key itself, not the id the header claims for it.
+    key = key_id(raw)
+    remarks: list[str] = []
+    trusted = find_trusted(raw)
+    if trusted is not None:
+        trust = f"trusted: {trusted.name}" if trusted.name else "trusted"
+    elif trust_any:
+        trust = "not in the trust store"
+        remarks.append(_UNTRUSTED_ALLOWED.format(key=key))
+    else:
+        return _Refusal(_UNTRUSTED.format(key=key, signs="signed" if finish else "recorded"), None)
+    if finish is None:
+        remarks.append(
+            f"The session is unfinished, so nothing in it is signed yet; its header names "
+            f"station key {key} ({trust})."
+        )
+        return key, "", remarks
+    return key, f"{key} ({trust})", remarks
+
+
+_UNSIGNED_OLD = (
+    "The session is unsigned: its header dates it {created}, before stations signed their "
+    "sessions. Nothing shows who wrote it: only the anchor on its filed report vouches for it."
+)
+_UNSIGNED_ALLOWED = (
+    "--allow-unsigned: the session is unsigned, though its header dates it {created}, when "
+    "stations sign every session. Nothing shows who wrote it."
+)
+_UNSIGNED_FORGED = (
+    "NOT trusted: the session is unsigned, though its header dates it {created}, when stations "
+    "sign every session: its signature was removed. Only for a file known to be unsigned, "
+    "check the chain with --allow-unsigned."
+)
+_UNTRUSTED_ALLOWED = (
+    "--trust-any: station key {key} is not in this station's trust store; the signature shows "
+    "only that whoever holds that key wrote the file."
+)
+_UNTRUSTED = (
+    "NOT trusted: the session is {signs} with station key {key}, which is not in this "
+    "station's trust store. If it is the key of the station that recorded the session, add it "
+    "with `station keys trust FILE.pub` (FILE.pub: what `station keys show` prints there)."
+)

@@ -71,7 +71,8 @@ def test_analyze_shows_hostile_csv_column_names_as_text(tmp_path: Path) -> None:
 def test_verify_and_export_show_a_hostile_file_name_and_reasons(tmp_path: Path, session) -> None:
     hostile_name = tmp_path / f"s{OSC_TITLE}\u202e.jsonl"
     hostile_name.write_bytes(session.read_bytes())
-    verify = station("verify", hostile_name)
+    # The module's session was recorded with another test's key: another station's, untrusted.
+    verify = station("verify", "--trust-any", hostile_name)
     assert verify.returncode == 0, verify.stdout + verify.stderr
     assert_plain(verify)
     assert "\\x1b]0;pwned" in verify.stdout

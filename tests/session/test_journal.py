@@ -107,7 +107,8 @@ def test_a_stored_session_from_before_the_anchor_change_still_loads() -> None:
     from station.session.verify import verify_session
 
     for path in files:
-        result = verify_session(path)
+        # Recorded on another station, whose key this test's station does not trust.
+        result = verify_session(path, trust_any=True)
         assert result.ok, result.message
         last_line = path.read_text(encoding="utf-8").splitlines()[-1]
         assert result.last_hash == json.loads(last_line)["hash"]
