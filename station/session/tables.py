@@ -126,7 +126,7 @@ def read_table(path: str | Path) -> ReadingTable:
             comments, header_line, names = _read_header(handle, path)
             if {name.lower() for name in names} >= TIDY_COLUMNS:
                 data_rows = [
-                    (number, next(csv.reader([line])))
+                    (number, _cells(line, path, number))
                     for number, line in enumerate(handle, start=header_line + 1)
                     if line.strip() and not line.lstrip().startswith("#")
                 ]
@@ -271,6 +271,28 @@ def _read_tidy(
     )
 
 
+CELL_LIMIT = csv.field_size_limit()
+"""The longest cell the csv module splits (128 KiB): no column name or reading is near it."""
+
+
+def _cells(line: str, path: Path, line_number: int) -> list[str]:
+    """The cells of one CSV line; a cell over :data:`CELL_LIMIT` (or a line the csv module
+    cannot split) is a StationError naming the file and the line."""
+    try:
+        return next(csv.reader([line]))
+    except csv.Error as error:
+        if "field limit" not in str(error):
+            raise StationError(
+                f"{plain(path)}: line {line_number} is not a CSV row ({plain(error)}); "
+                "fix the line."
+            ) from None
+        raise StationError(
+            f"{plain(path)}: line {line_number} has a cell longer than {CELL_LIMIT >> 10} KiB, "
+            "which is no column name or reading; check that it is the right file, or shorten "
+            "the cell."
+        ) from None
+
+
 def _load_rows(lines: Any, columns: int) -> np.ndarray:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # "input contained no data" for a header-only file
@@ -301,7 +323,7 @@ def _read_header(handle: Any, path: Path) -> tuple[list[str], int, list[str]]:
         if stripped.startswith("#"):
             comments.append(stripped[1:].strip())
             continue
-        cells = next(csv.reader([line]))
+        cells = _cells(line, path, line_number)
         return comments, line_number, [cell.strip() for cell in cells]
 
 
@@ -345,7 +367,7 @@ def _diagnose(
         if not header_seen:
             header_seen = True
             continue
-        cells = next(csv.reader([line]))
+        cells = _cells(line, path, line_number)
         if len(cells) != len(names):
             raise StationError(
                 f"{plain(path)}: line {line_number} has {len(cells)} cells but the header has "

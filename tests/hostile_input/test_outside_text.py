@@ -1,0 +1,59 @@
+"""Issue 27, findings 2, 3, 4 and 7: text from outside (a CSV header, an output name, a
+channel name, an index column) is text; too much of it is one sentence, never a traceback."""
+
+from __future__ import annotations
+
+import subprocess
+
+import pytest
+from helpers import run_station
+
+READINGS = "".join(f"{(k % 7 - 3) / 10000},{(k % 5 - 2) / 10000}\n" for k in range(30))
+HUGE_CELL = "h" * (140 << 10)
+"""Over the csv module's 128 KiB field limit."""
+
+
+def one_sentence(result: subprocess.CompletedProcess, *words: str) -> str:
+    """Exit 2 with one ``station: ...`` line on stderr naming ``words``; the line."""
+    assert result.returncode == 2, (result.returncode, result.stdout[-500:], result.stderr[-2000:])
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("station: "), result.stderr[-2000:]
+    for word in words:
+        assert word in lines[0], lines[0]
+    return lines[0]
+
+
+# -- finding 2: a CSV cell over 128 KiB -------------------------------------------------------
+
+PROCEDURES = (
+    "repeatability",
+    "linearity",
+    "relative_accuracy",
+    "gauge_check",
+    "gauge_linearity",
+    "joint_troubleshooting",
+    "gain_schedule",
+)
+
+
+@pytest.mark.parametrize("procedure", PROCEDURES)
+def test_a_header_cell_over_128_kib_is_one_sentence_in_every_analysis(tmp_path, procedure):
+    table = tmp_path / "long-header.csv"
+    table.write_text(f"cycle,{HUGE_CELL}\n" + READINGS)
+    result = run_station("analyze", table, "--procedure", procedure)
+    one_sentence(result, "long-header.csv", "line 1", "128 KiB")
+
+
+def test_a_reading_cell_and_a_tidy_cell_over_128_kib_name_their_line(tmp_path):
+    wide = tmp_path / "wide.csv"
+    wide.write_text("x,y\n" + READINGS + f"0.1,{HUGE_CELL}\n")
+    one_sentence(run_station("analyze", wide), "wide.csv", "line 32", "128 KiB")
+    tidy = tmp_path / "tidy.csv"
+    tidy.write_text(f"cycle,channel,value\n1,x,0.1\n2,{HUGE_CELL},0.1\n")
+    one_sentence(run_station("analyze", tidy), "tidy.csv", "line 3", "128 KiB")
+
+
+def test_gains_fit_says_a_header_cell_is_over_128_kib(tmp_path):
+    gains = tmp_path / "gains.csv"
+    gains.write_text(f"q,{HUGE_CELL}\n" + "".join(f"{q},{1 + q / 100}\n" for q in range(9)))
+    one_sentence(run_station("gains", "fit", gains), "gains.csv", "line 1", "128 KiB")
