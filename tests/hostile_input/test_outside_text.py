@@ -4,9 +4,11 @@ channel name, an index column) is text; too much of it is one sentence, never a 
 from __future__ import annotations
 
 import subprocess
+from pathlib import Path
 
 import pytest
 from helpers import run_station
+from record.conftest import write_repeatability
 
 READINGS = "".join(f"{(k % 7 - 3) / 10000},{(k % 5 - 2) / 10000}\n" for k in range(30))
 HUGE_CELL = "h" * (140 << 10)
@@ -57,3 +59,42 @@ def test_gains_fit_says_a_header_cell_is_over_128_kib(tmp_path):
     gains = tmp_path / "gains.csv"
     gains.write_text(f"q,{HUGE_CELL}\n" + "".join(f"{q},{1 + q / 100}\n" for q in range(9)))
     one_sentence(run_station("gains", "fit", gains), "gains.csv", "line 1", "128 KiB")
+
+
+# -- finding 3: an output name over 255 bytes -------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory) -> Path:
+    return write_repeatability(tmp_path_factory.mktemp("sessions"))
+
+
+@pytest.mark.parametrize(
+    "command",
+    [("report", "--format", "html"), ("export", "--csv")],
+    ids=["report", "export"],
+)
+def test_an_output_name_over_255_bytes_is_one_sentence(tmp_path, session, command):
+    out = tmp_path / ("r" * 300)
+    result = run_station(command[0], session, *command[1:], "-o", out)
+    line = one_sentence(result, "longer than the file system allows", "shorter name")
+    assert len(line) < 300, line
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    "command",
+    [("report", "--format", "html"), ("export", "--csv")],
+    ids=["report", "export"],
+)
+def test_an_output_in_a_missing_folder_is_one_sentence(tmp_path, session, command):
+    out = tmp_path / "missing" / "out"
+    result = run_station(command[0], session, *command[1:], "-o", out)
+    one_sentence(result, "does not exist", "create it first")
+
+
+def test_gains_fit_c_header_over_255_bytes_is_one_sentence(tmp_path):
+    gains = tmp_path / "gains.csv"
+    gains.write_text("q,kp\n" + "".join(f"{q},{1 + q / 100}\n" for q in range(9)))
+    result = run_station("gains", "fit", gains, "--c", tmp_path / ("g" * 300 + ".h"))
+    one_sentence(result, "longer than the file system allows")
