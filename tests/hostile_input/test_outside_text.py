@@ -98,3 +98,52 @@ def test_gains_fit_c_header_over_255_bytes_is_one_sentence(tmp_path):
     gains.write_text("q,kp\n" + "".join(f"{q},{1 + q / 100}\n" for q in range(9)))
     result = run_station("gains", "fit", gains, "--c", tmp_path / ("g" * 300 + ".h"))
     one_sentence(result, "longer than the file system allows")
+
+
+# -- finding 7: a row-number column is no channel ---------------------------------------------
+
+CAPABLE_READINGS = [(k % 7 - 3) / 10000 for k in range(30)]
+"""Readings well inside ±0.001 (Cpk about 1.6)."""
+
+
+@pytest.mark.parametrize("index", ["sample", "Sample", "ID", "index", "Obs"])
+def test_a_row_number_column_as_spreadsheets_name_it_is_not_a_channel(tmp_path, index):
+    table = tmp_path / "minitab.csv"
+    rows = "".join(f"{k},{value}\n" for k, value in enumerate(CAPABLE_READINGS, start=1))
+    table.write_text(f"{index},x\n" + rows)
+    result = run_station(
+        "analyze", table, "--lsl", "-0.001", "--usl", "0.001", "--fail-if-incapable"
+    )
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    assert f"FEATURE: {index}" not in result.stdout and "FEATURE: x" in result.stdout
+
+
+def test_a_column_that_counts_the_rows_is_left_out_with_a_note(tmp_path):
+    table = tmp_path / "excel.csv"
+    rows = "".join(f"{k},{value}\n" for k, value in enumerate(CAPABLE_READINGS, start=1))
+    table.write_text("n,x\n" + rows)
+    limits = ("--lsl", "-0.001", "--usl", "0.001", "--fail-if-incapable")
+    result = run_station("analyze", table, *limits)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    assert "FEATURE: n" not in result.stdout
+    assert "column 'n' counts the rows" in result.stdout
+    as_json = run_station("analyze", table, *limits, "--json")
+    assert as_json.returncode == 0, as_json.stderr
+    assert "station: note: column 'n' counts the rows" in as_json.stderr
+
+
+def test_a_counting_column_a_method_reads_by_name_stays(tmp_path):
+    # A gains table's positions may well be 1, 2, 3 ...: q is the method's own column.
+    gains = tmp_path / "gains.csv"
+    gains.write_text("q,kp\n" + "".join(f"{q},{1 + q * q / 100}\n" for q in range(1, 10)))
+    result = run_station("analyze", gains, "--procedure", "gain_schedule")
+    assert result.returncode == 0, result.stderr
+    assert "counts the rows" not in result.stdout
+
+
+def test_a_lone_column_of_counting_readings_is_still_analysed(tmp_path):
+    table = tmp_path / "coarse.csv"
+    table.write_text("x\n" + "".join(f"{k}\n" for k in range(1, 31)))
+    result = run_station("analyze", table)
+    assert result.returncode == 0, result.stderr
+    assert "FEATURE: x" in result.stdout
