@@ -3,11 +3,16 @@ channel name, an index column) is text; too much of it is one sentence, never a 
 
 from __future__ import annotations
 
+import json
+import re
 import subprocess
+import warnings
+from datetime import UTC, datetime
 from pathlib import Path
 
 import pytest
 from helpers import run_station
+from hostile import raw_controls
 from record.conftest import write_repeatability
 
 READINGS = "".join(f"{(k % 7 - 3) / 10000},{(k % 5 - 2) / 10000}\n" for k in range(30))
@@ -147,3 +152,87 @@ def test_a_lone_column_of_counting_readings_is_still_analysed(tmp_path):
     result = run_station("analyze", table)
     assert result.returncode == 0, result.stderr
     assert "FEATURE: x" in result.stdout
+
+
+# -- finding 4: channel names and units in charts and exports ---------------------------------
+
+MATHTEXT = "$\\frac{1}{$"
+CONTROLS = "y\x1b]0;pwned\x07\x9b31m"
+LONG_NAME = "N" * 100_000
+
+
+def named_session(folder: Path, names: dict[str, str], unit: str) -> Path:
+    """A finished repeatability session whose channels x, y, z are called ``names`` and whose
+    readings are in ``unit``: the header production writes, renamed."""
+    from session.conftest import session_header_fields
+
+    from station.session.journal import SessionWriter
+
+    text = json.dumps(session_header_fields(robot="r2", operator="ana"))
+    for old, new in names.items():
+        text = text.replace(json.dumps(old), json.dumps(new))
+    header = json.loads(text) | {"unit": unit}
+    folder.mkdir(exist_ok=True)
+    with SessionWriter.create(folder, header, now=datetime(2026, 11, 23, 12, tzinfo=UTC)) as w:
+        for cycle in range(1, 31):
+            channels = {}
+            for index, name in enumerate([names.get(c, c) for c in ("x", "y", "z")]):
+                value = round(((cycle * 7 + index * 3) % 11 - 5) * 0.0001, 4)
+                channels[name] = {
+                    "value": value,
+                    "raw_value": value,
+                    "zero": 0.0,
+                    "unit": unit,
+                    "raw": f"0{index + 1}A{value:+.4f}",
+                    "t_mono": 1000.0 + cycle,
+                    "t_wall": 1.7e9 + cycle,
+                }
+            w.append("reading", cycle=cycle, step="cycles", channels=channels)
+        w.append("finish", verdict="capable")
+    return w.path
+
+
+def svg_text(html: str) -> str:
+    return "".join(re.findall(r"<svg.*?</svg>", html, flags=re.DOTALL))
+
+
+def test_mathtext_and_controls_in_names_are_text_in_the_html_report(tmp_path):
+    session = named_session(tmp_path / "s", {"x": MATHTEXT, "y": CONTROLS}, "in\x07$")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = run_station("report", session, "--format", "html", "-o", tmp_path / "r.html")
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert [str(w.message) for w in caught] == []
+    html = (tmp_path / "r.html").read_text()
+    assert raw_controls(html) == []
+    svg = svg_text(html)
+    assert MATHTEXT in svg  # shown as typed, not parsed as maths
+    assert "y\\x1b]0;pwned\\x07\\x9b31m" in svg and "in\\x07$" in svg
+
+
+def test_a_glyph_the_font_lacks_warns_nobody(tmp_path):
+    session = named_session(tmp_path / "s", {"x": "軸\U0001f916"}, "mm")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = run_station("report", session, "--format", "html")
+    assert result.returncode == 0 and result.stderr == "", result.stderr[-2000:]
+    assert [str(w.message) for w in caught] == []
+
+
+def test_a_100k_character_name_is_cut_in_the_charts(tmp_path):
+    session = named_session(tmp_path / "s", {"x": LONG_NAME}, "mm")
+    result = run_station("report", session, "--format", "html")
+    assert result.returncode == 0, result.stderr[-2000:]
+    svg = svg_text(result.stdout)
+    assert "N" * 59 + "…" in svg and "N" * 61 not in svg
+
+
+@pytest.mark.parametrize("layout", ["tidy", "wide"])
+def test_controls_in_names_and_units_are_visible_in_the_csv_export(tmp_path, layout):
+    session = named_session(tmp_path / "s", {"y": CONTROLS}, "in\x07")
+    out = tmp_path / "out.csv"
+    result = run_station("export", session, "--csv", "--layout", layout, "-o", out)
+    assert result.returncode == 0, result.stderr
+    text = out.read_text()
+    assert raw_controls(text) == []
+    assert "y\\x1b]0;pwned\\x07\\x9b31m" in text
