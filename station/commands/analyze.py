@@ -18,6 +18,7 @@ from station.commands._args import (
     parse_number,
 )
 from station.errors import StationError
+from station.plain import plain
 
 if TYPE_CHECKING:
     from station.analysis.summary import AnalysisConfig
@@ -36,8 +37,9 @@ DESCRIPTION = """\
 Analyse readings the way the 1990 NASA/KSC report does: maximum, average,
 minimum, sigma, skewness, range, mode, histogram, control chart with run rules,
 Cp/Cpu/Cpl/Cpk and the verdict. FILE is a CSV table (a header row, '#' comment
-lines, one numeric column per channel; columns named cycle, subgroup or t are
-not channels) or a session file (.jsonl).
+lines, one numeric column per channel; columns named cycle, subgroup, t,
+sample, id, index or obs are not channels, nor is a column that counts the rows
+1, 2, 3 ...) or a session file (.jsonl).
 
 --procedure linearity reads a CSV with columns stroke, s, h, v (one row per
 streamed point) and adds the straightness per stroke (least squares and minimum
@@ -193,6 +195,31 @@ def load_source(path: Path) -> Any:
     )
 
 
+def without_row_counters(source: TableSource) -> TableSource:
+    """``source`` without the channel columns that only count the rows (1, 2, 3 ...: a row
+    number a spreadsheet wrote under a name of its own), each named in a note; as it is when
+    every channel counts (then they are the readings) or for a tidy table (its rows are
+    readings by name)."""
+    from station.session.tables import row_counters
+
+    counters = () if source.table.channel_cycles is not None else row_counters(source.channels)
+    if not counters or len(counters) == len(source.channels):
+        return source
+    notes = tuple(
+        f"column {plain(name, limit=40)!r} counts the rows 1, 2, 3 ...: taken as a row number, "
+        "not a channel (name it cycle to say so)."
+        for name in counters
+    )
+    return replace(
+        source,
+        channels={n: v for n, v in source.channels.items() if n not in counters},
+        cycles=None
+        if source.cycles is None
+        else {n: v for n, v in source.cycles.items() if n not in counters},
+        notes=source.notes + notes,
+    )
+
+
 @dataclass(frozen=True)
 class TableSource:
     """What a CSV table gives the analysis (the attributes a ``SessionSource`` also has)."""
@@ -205,12 +232,12 @@ class TableSource:
     notes: tuple[str, ...] = ()
 
 
-def table_times(table: Any) -> dict[str, Any] | None:
-    """The time of each channel's readings when the table dates its rows (a ``t`` column, a
-    tidy table's ``time``), for the drift's trend; None otherwise."""
-    if table.times is None or any(len(v) != len(table.times) for v in table.channels.values()):
+def table_times(table: Any, channels: dict[str, Any]) -> dict[str, Any] | None:
+    """The time of each of ``channels``' readings when the table dates its rows (a ``t``
+    column, a tidy table's ``time``), for the drift's trend; None otherwise."""
+    if table.times is None or any(len(v) != len(table.times) for v in channels.values()):
         return None
-    return {name: table.times for name in table.channels}
+    return {name: table.times for name in channels}
 
 
 def method_options(method: Any, given: dict[str, float | None]) -> dict[str, float]:
@@ -292,6 +319,9 @@ def run(args: argparse.Namespace) -> int:
 
     if isinstance(source, TableSource):
         method = method_of(args.procedure or names()[0])
+        if not method.reads_columns_by_name:
+            source = without_row_counters(source)
+            channels = source.channels
     else:
         method = method_of(args.procedure or session_method(source.session))
     tolerance = parse_number(args.tolerance, "--tolerance")
@@ -316,11 +346,11 @@ def run(args: argparse.Namespace) -> int:
             channels=channels,
             cycles=source.cycles,
             excluded_cycles=source.excluded_cycles,
-            times=table_times(source.table),
+            times=table_times(source.table, channels),
             options=options,
             table=source.table,
         )
-        report = judge(method, inputs, name=path.name)
+        report = judge(method, inputs, name=path.name, notes=source.notes)
     else:
         report = report_session(source, config=config, method=method.name, options=options)
     if report.empty:
@@ -328,6 +358,9 @@ def run(args: argparse.Namespace) -> int:
     analysis = report.analysis
 
     if args.json:
+        if isinstance(source, TableSource):  # the text report shows them; JSON has no place
+            for note in source.notes:
+                print(f"station: note: {note}", file=sys.stderr)
         # Indented for a person at a terminal; compact (json's C encoder, several times faster
         # on a document of thousands of alarms) when a script reads it.
         indent = 2 if sys.stdout.isatty() else None

@@ -6,8 +6,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from station.errors import StationError
-
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register ``station export``."""
@@ -47,8 +45,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Export; StationError for a missing session or an existing OUT without --force."""
+    from station.commands._output import write_output_file
     from station.record.export import default_layout, export_table
-    from station.session.durable import replace_durably
     from station.session.model import load_session
 
     session = load_session(args.file, recover=False)
@@ -60,16 +58,13 @@ def run(args: argparse.Namespace) -> int:
         export_table(session, sys.stdout, layout)
         return 0
     out = Path(args.output)
-    try:
-        # Synced before the rename and the folder after: OUT is whole or absent after a crash.
-        # Never written through a link, and never over the session file itself.
-        rows = replace_durably(
-            out,
-            lambda handle: export_table(session, handle, layout),
-            overwrite=args.force,
-            not_over=Path(args.file),
-        )
-    except OSError as error:
-        raise StationError(f"cannot write {out}: {error.strerror}") from None
+    # Synced before the rename and the folder after: OUT is whole or absent after a crash.
+    # Never written through a link, and never over the session file itself.
+    rows = write_output_file(
+        out,
+        lambda handle: export_table(session, handle, layout),
+        force=args.force,
+        source=Path(args.file),
+    )
     print(f"wrote {rows} rows to {out}", file=sys.stderr)
     return 0

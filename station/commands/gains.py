@@ -7,9 +7,9 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from station.commands._output import write_output_file
 from station.errors import StationError
 from station.plain import plain
-from station.session.durable import write_text_durably
 
 if TYPE_CHECKING:
     from station.analysis.gain_schedule import GainFit, GainSchedule
@@ -163,15 +163,11 @@ def format_fit(fit: GainFit, *, plot: bool = True) -> list[str]:
 
 
 def write_c_header(text: str, target: Path, source: Path) -> None:
-    """Write ``text`` to ``target`` in full or not at all (the station's one durable writer:
-    never through a symlink, never over the input file)."""
-    folder = target.parent if str(target.parent) else Path(".")
-    if not folder.is_dir():
-        raise StationError(f"--c {target}: folder {folder} does not exist.")
-    try:
-        write_text_durably(target, text, not_over=source, mode=0o644)
-    except OSError as error:
-        raise StationError(f"cannot write {target}: {error.strerror or error}.") from None
+    """Write ``text`` to ``target`` in full or not at all (the commands' one output writer:
+    never through a symlink, never over the input file; an existing header is replaced)."""
+    write_output_file(
+        target, lambda handle: handle.write(text), force=True, source=source, mode=0o644
+    )
 
 
 def run(args: argparse.Namespace) -> int:

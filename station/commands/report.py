@@ -6,8 +6,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from station.errors import StationError
-
 FORMATS = ("txt", "md", "html")
 
 
@@ -44,7 +42,9 @@ def output_format(requested: str | None, output: str | None) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Render the report; StationError for a bad session, an OUT that is FILE or exists."""
+    """Render the report; StationError for a bad session, or an OUT that is FILE, exists, is a
+    link or cannot be written (see :func:`~station.commands._output.write_output_file`)."""
+    from station.commands._output import check_output_file, write_output_file
     from station.record.render import render_report
 
     fmt = output_format(args.format, args.output)
@@ -53,18 +53,9 @@ def run(args: argparse.Namespace) -> int:
         sys.stdout.write(render_report(source, fmt))
         return 0
     out = Path(args.output)
-    if out.exists() and source.exists() and out.resolve() == source.resolve():
-        raise StationError(f"{out} is the session file itself; choose another name for the report")
-    if out.is_symlink():
-        raise StationError(f"{out} is a symbolic link; give a plain file name for the report")
-    if out.exists() and not args.force:
-        raise StationError(f"{out} exists; pass --force to overwrite it or choose another name")
+    # Checked before the report is rendered: a refused OUT costs nothing.
+    check_output_file(out, force=args.force, source=source)
     text = render_report(source, fmt)
-    from station.session.durable import replace_durably
-
-    try:
-        replace_durably(out, lambda handle: handle.write(text))
-    except OSError as error:
-        raise StationError(f"cannot write {out}: {error.strerror}") from None
+    write_output_file(out, lambda handle: handle.write(text), force=args.force, source=source)
     print(f"wrote the {fmt} report of {source.name} to {out}", file=sys.stderr)
     return 0

@@ -270,6 +270,10 @@ class Method(ABC):
     """The command line's values (:data:`OPTIONS`) its batch analysis takes."""
     export_layout: ClassVar[Layout] = "tidy"
     """The CSV layout ``station export`` writes by default."""
+    reads_columns_by_name: ClassVar[bool] = False
+    """Whether its batch reads a CSV table by column name (linearity's stroke, s, h, v; a gains
+    table's q) rather than each column as a channel: then no column is left out for counting
+    the rows (``station analyze``), since 1, 2, 3 ... may be its own positions or joints."""
     drift_chart: ClassVar[bool] = True
     """Whether its report draws the readings over time (cycles in time order; not strokes)."""
     files_in_register: ClassVar[bool] = False

@@ -6,13 +6,18 @@ profiles along the bar, a gauge study's bias against the size: :meth:`Method.cha
 histogram of each judged channel against its limits, the control chart with its limits and the
 alarms marked, the 3-D offsets of x, y, z, and the readings over time with their trend (drift)
 where the method's readings are cycles in time order. Text is kept as SVG text (searchable,
-small), and maths parsing is off: a channel name is shown as typed.
+small). A channel name or a unit comes from outside and is shown as text: maths parsing is off
+while every chart is drawn (``$\\frac{1}{$`` would stop the report), its control characters
+are made visible (:func:`chart_text`) and a long one is cut with a mark (a 100,000-character
+name laid out by matplotlib took minutes), and matplotlib's warnings (a glyph the font lacks)
+stay off the terminal.
 """
 
 from __future__ import annotations
 
 import io
 import re
+import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
@@ -20,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from station.methods import Judgement
+from station.plain import plain
 from station.record.content import parse_time
 from station.record.source import AnalysedSession
 
@@ -36,6 +42,14 @@ CENTRE_COLOUR = "#2c3e50"
 POINT_COLOUR = "#1f77b4"
 ALARM_COLOUR = "#d62728"
 _METADATA_KEYS = ("Date", "Creator", "Format", "Type")
+CHART_TEXT_LIMIT = 60
+"""The most characters of outside text (a channel name, a unit) a chart shows."""
+
+
+def chart_text(text: object) -> str:
+    """Text from outside (a channel name, a unit) as a chart shows it: controls made visible,
+    cut to :data:`CHART_TEXT_LIMIT` characters with an ellipsis."""
+    return plain(text, limit=CHART_TEXT_LIMIT)
 
 
 @dataclass(frozen=True)
@@ -70,6 +84,7 @@ def _figure(width: float = 7.0, height: float = 3.2) -> Any:
 
 def histogram_chart(name: str, channel: Any, unit: str) -> Any:
     """The readings' histogram with LSL, USL, nominal and the mean marked."""
+    name, unit = chart_text(name), chart_text(unit)
     figure = _figure()
     axes = figure.add_subplot()
     values = np.asarray(channel.readings, dtype=float)
@@ -93,6 +108,7 @@ def control_chart(name: str, channel: Any, xlabel: str = "cycle") -> Any:
     """The location chart: points by cycle (or stroke), centre line, control limits, alarms
     circled in red."""
     chart = channel.chart
+    name = chart_text(name)
     figure = _figure()
     axes = figure.add_subplot()
     points = np.asarray(chart.points, dtype=float)
@@ -132,6 +148,7 @@ def offsets_chart(analysis: Any, unit: str) -> Any:
     channels = analysis.channels
     names = [n for n in channels if n.lower() in ("x", "y", "z")]
     arrays = [np.asarray(channels[n].readings, dtype=float) for n in names]
+    unit = chart_text(unit)
     figure = _figure(5.5, 4.5)
     axes = figure.add_subplot(projection="3d")
     axes.scatter(*arrays, s=8, color=POINT_COLOUR, alpha=0.6, label="readings")
@@ -174,10 +191,12 @@ def drift_chart(analysed: AnalysedSession, unit: str) -> Any | None:
         return None
     span = max(float(np.ptp(seconds)) for seconds, _ in series.values())
     scale, label = (1.0, "s") if span < 120 else (60.0, "min") if span < 7200 else (3600.0, "h")
+    unit = chart_text(unit)
     figure = _figure()
     axes = figure.add_subplot()
     for channel, (seconds, values) in series.items():
         elapsed = seconds / scale
+        channel = chart_text(channel)
         (line,) = axes.plot(elapsed, values, marker=".", linewidth=0.8, label=channel)
         if np.ptp(elapsed) > 0:
             slope, intercept = np.polyfit(elapsed, values, 1)
@@ -210,8 +229,8 @@ class _Kit:
         return _figure(width, height)
 
     def label(self, text: object) -> str:
-        """Text from outside as a chart shows it."""
-        return str(text)
+        """Text from outside as a chart shows it (:func:`chart_text`)."""
+        return chart_text(text)
 
 
 def _figures(analysed: AnalysedSession) -> Iterator[tuple[str, str, Any]]:
@@ -228,13 +247,13 @@ def _figures(analysed: AnalysedSession) -> Iterator[tuple[str, str, Any]]:
     for key, channel in analysis.channels.items():
         yield (
             f"histogram-{key}",
-            f"Histogram of {channel.name}",
+            f"Histogram of {chart_text(channel.name)}",
             histogram_chart(channel.name, channel, unit),
         )
         if channel.chart.points:
             yield (
                 f"control-{key}",
-                f"Control chart of {channel.name}",
+                f"Control chart of {chart_text(channel.name)}",
                 control_chart(channel.name, channel),
             )
     if analysis.spatial is not None:
@@ -250,8 +269,15 @@ _SAFE_KEY = re.compile(r"[^A-Za-z0-9_-]")
 
 def report_charts(analysed: AnalysedSession) -> list[Chart]:
     """Every chart of the session's report, as SVG (empty without an analysis)."""
+    from matplotlib import rc_context
+
     charts = []
-    for number, (key, title, figure) in enumerate(_figures(analysed)):
-        safe = f"{number}-{_SAFE_KEY.sub('_', key)}"
-        charts.append(Chart(key=safe, title=title, svg=_svg(figure, f"station-chart-{safe}")))
+    # Drawn under RC, not only saved: a text artist reads text.parse_math when it is made, so
+    # a title or a legend made outside would still parse a channel name as maths.
+    with rc_context(RC), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for number, (key, title, figure) in enumerate(_figures(analysed)):
+            safe = f"{number}-{_SAFE_KEY.sub('_', key)}"
+            svg = _svg(figure, f"station-chart-{safe}")
+            charts.append(Chart(key=safe, title=title, svg=svg))
     return charts

@@ -13,6 +13,7 @@ from __future__ import annotations
 from typing import TextIO
 
 from station.methods import method_of, session_method
+from station.plain import PlainStream
 from station.session.export import export_csv
 from station.session.model import Session
 
@@ -26,9 +27,10 @@ def default_layout(session: Session) -> str:
 
 def export_table(session: Session, out: TextIO, layout: str = "tidy") -> int:
     """Write ``session`` as CSV in ``layout`` (``tidy`` or ``wide``, see the module); return
-    the data rows."""
+    the data rows. Control characters from outside (a channel name, a unit, a reject reason)
+    are written visible, whichever method writes the rows."""
     if layout == "tidy":
         return export_csv(session, out)
     if layout != "wide":
         raise ValueError(f"unknown CSV layout {layout!r}")
-    return method_of(session_method(session)).write_wide(session, out)
+    return method_of(session_method(session)).write_wide(session, PlainStream(out))

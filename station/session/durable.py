@@ -110,13 +110,13 @@ def write_text_durably(
 
 def check_output_path(path: Path, *, overwrite: bool = True, not_over: Path | None = None) -> None:
     """StationError when ``path`` may not be written: a symbolic link, not a regular file, an
-    existing file without ``overwrite``, or the same file as ``not_over``."""
+    existing file without ``overwrite``, or the same file as ``not_over``. OSError when its
+    name cannot even be looked up (too long, a file where a folder should be, no permission),
+    for the caller to word as it words a failed write."""
     try:
         info = os.lstat(path)
     except FileNotFoundError:
         return
-    except OSError as error:
-        raise StationError(f"cannot write {path}: {error.strerror}") from None
     if stat.S_ISLNK(info.st_mode):
         raise StationError(
             f"{path} is a symbolic link; station does not write through links: remove it or "

@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 from typing import TextIO
 
+from station.plain import PlainStream
 from station.session.model import Session
 
 CSV_COLUMNS: tuple[str, ...] = (
@@ -30,9 +31,11 @@ def export_csv(session: Session, out: TextIO) -> int:
     """Write the session's cycles to ``out`` as CSV (header row first); return the data rows.
 
     ``status`` is ``ok`` or ``rejected: <reason>`` (readings are never deleted, so rejected
-    cycles stay in the export, marked); ``time`` is the event's ISO-8601 UTC time.
+    cycles stay in the export, marked); ``time`` is the event's ISO-8601 UTC time. A channel
+    name or a unit is text from outside: its control characters are written visible
+    (``\\x1b``), as a terminal shows them, so a spreadsheet or ``cat`` of the file is safe.
     """
-    writer = csv.writer(out, lineterminator="\n")
+    writer = csv.writer(PlainStream(out), lineterminator="\n")
     writer.writerow(CSV_COLUMNS)
     rows = 0
     for number in sorted(session.cycles):

@@ -5,7 +5,9 @@ cycle, one numeric column per channel. The tidy layout ``station export`` writes
 cycle and channel: columns cycle, channel, value, status ...) is read too and turned into one
 column per channel, rejected rows left out. Lines whose first non-blank character is ``#`` are
 comments (where the data came from, the unit) and blank lines are skipped. Columns named
-``cycle``, ``subgroup`` or ``t`` (any case) number or time the rows; they are not channels.
+``cycle``, ``subgroup`` or ``t`` (any case) number or time the rows, and so do ``sample``,
+``id``, ``index`` and ``obs`` (the row numbers Minitab, JASP and Excel export): they are not
+channels. :func:`row_counters` finds a column of another name that only counts the rows.
 
 Every problem is a :class:`~station.errors.StationError` that names the file, and where it
 helps the line (1-based, counted in the file as an editor shows it) and the column.
@@ -29,7 +31,12 @@ from station.session.model import event_seconds
 from station.session.replay import CYCLE_LIMIT, READING_LIMIT
 
 #: Column names (compared case-insensitively) that index the rows instead of holding readings.
-INDEX_COLUMNS: frozenset[str] = frozenset({"cycle", "subgroup", "t"})
+INDEX_COLUMNS: frozenset[str] = frozenset(
+    {"cycle", "subgroup", "t", "sample", "id", "index", "obs"}
+)
+ROW_COUNT_MINIMUM = 5
+"""The fewest rows at which a column holding exactly 1, 2, 3 ... n (or 0 ... n-1) is taken
+for a row number: a gauge's readings run so in order by chance only in a very short table."""
 
 
 @dataclass(frozen=True)
@@ -126,7 +133,7 @@ def read_table(path: str | Path) -> ReadingTable:
             comments, header_line, names = _read_header(handle, path)
             if {name.lower() for name in names} >= TIDY_COLUMNS:
                 data_rows = [
-                    (number, next(csv.reader([line])))
+                    (number, _cells(line, path, number))
                     for number, line in enumerate(handle, start=header_line + 1)
                     if line.strip() and not line.lstrip().startswith("#")
                 ]
@@ -271,6 +278,28 @@ def _read_tidy(
     )
 
 
+CELL_LIMIT = csv.field_size_limit()
+"""The longest cell the csv module splits (128 KiB): no column name or reading is near it."""
+
+
+def _cells(line: str, path: Path, line_number: int) -> list[str]:
+    """The cells of one CSV line; a cell over :data:`CELL_LIMIT` (or a line the csv module
+    cannot split) is a StationError naming the file and the line."""
+    try:
+        return next(csv.reader([line]))
+    except csv.Error as error:
+        if "field limit" not in str(error):
+            raise StationError(
+                f"{plain(path)}: line {line_number} is not a CSV row ({plain(error)}); "
+                "fix the line."
+            ) from None
+        raise StationError(
+            f"{plain(path)}: line {line_number} has a cell longer than {CELL_LIMIT >> 10} KiB, "
+            "which is no column name or reading; check that it is the right file, or shorten "
+            "the cell."
+        ) from None
+
+
 def _load_rows(lines: Any, columns: int) -> np.ndarray:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # "input contained no data" for a header-only file
@@ -301,7 +330,7 @@ def _read_header(handle: Any, path: Path) -> tuple[list[str], int, list[str]]:
         if stripped.startswith("#"):
             comments.append(stripped[1:].strip())
             continue
-        cells = next(csv.reader([line]))
+        cells = _cells(line, path, line_number)
         return comments, line_number, [cell.strip() for cell in cells]
 
 
@@ -345,7 +374,7 @@ def _diagnose(
         if not header_seen:
             header_seen = True
             continue
-        cells = next(csv.reader([line]))
+        cells = _cells(line, path, line_number)
         if len(cells) != len(names):
             raise StationError(
                 f"{plain(path)}: line {line_number} has {len(cells)} cells but the header has "
@@ -361,6 +390,21 @@ def _diagnose(
                     f"{plain(cells[index].strip(), limit=40)!r} is not a cycle number "
                     "(1, 2, 3 ...); fix the cell or delete the row."
                 )
+
+
+def row_counters(channels: dict[str, np.ndarray]) -> tuple[str, ...]:
+    """The channel columns that only count the rows (1, 2, 3 ... n or 0, 1 ... n-1, at least
+    :data:`ROW_COUNT_MINIMUM` rows): a row number a spreadsheet wrote under a name of its own
+    (``n``, ``no``, ``row``), which analysed as a channel would fail a capable run."""
+    counters = []
+    for name, values in channels.items():
+        n = len(values)
+        if n < ROW_COUNT_MINIMUM:
+            continue
+        steps = np.arange(n, dtype=np.float64)
+        if np.array_equal(values, steps + 1) or np.array_equal(values, steps):
+            counters.append(name)
+    return tuple(counters)
 
 
 def require_columns(

@@ -220,7 +220,7 @@ def test_report_command_writes_refuses_and_chooses_the_format(sessions, capsys):
     assert run_station("report", str(path), "-o", str(out)) == 2
     assert "exists; pass --force" in capsys.readouterr().err
     assert run_station("report", str(path), "-o", str(path), "--force") == 2
-    assert "is the session file itself" in capsys.readouterr().err
+    assert "is the input file itself" in capsys.readouterr().err
     assert run_station("report", str(path), "--format", "txt") == 0
     assert capsys.readouterr().out == render_report(path, "txt")
     assert run_station("report", str(sessions / "missing.jsonl")) == 2

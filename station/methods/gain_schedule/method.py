@@ -58,6 +58,7 @@ class GainScheduleMethod(Method):
 
     name = "gain_schedule"
     title = "GAIN SCHEDULE REPORT"
+    reads_columns_by_name = True
     needs = AnalysisNeeds(
         numbers=("q",),
         more_numbers=1,

@@ -163,6 +163,7 @@ class GaugeLinearity(Method):
 
     name = NAME
     title = "GAUGE LINEARITY AND BIAS REPORT"
+    reads_columns_by_name = True
     needs = AnalysisNeeds(
         facet="counts",
         facet_in_block=True,

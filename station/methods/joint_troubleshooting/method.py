@@ -67,6 +67,7 @@ class JointTroubleshooting(Method):
 
     name = "joint_troubleshooting"
     title = "PER-JOINT TROUBLESHOOTING REPORT"
+    reads_columns_by_name = True
     needs = AnalysisNeeds(
         facet="counts",
         facet_in_block=True,

@@ -91,6 +91,7 @@ class Linearity(Method):
 
     name = "linearity"
     title = "LINEARITY REPORT"
+    reads_columns_by_name = True
     needs = AnalysisNeeds(
         facet="direction", facet_words="a stroke step (streamed strokes)", implied=True
     )

@@ -83,6 +83,7 @@ class RelativeAccuracy(Method):
 
     name = "relative_accuracy"
     title = "RELATIVE ACCURACY REPORT"
+    reads_columns_by_name = True
     needs = AnalysisNeeds(
         facet="block",
         facet_words="a repeat block (one per placement)",
