@@ -37,12 +37,12 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     Registering one command imports only its module: the TUI and each command start without
     loading the others (``station --help`` and a mistyped command still see them all).
     """
-    import argparse
     import importlib
 
     from station import __version__
+    from station.commands._parser import OneLineParser
 
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="station",
         description=(
             "Acquisition station for robot calibration: repeatability, relative accuracy and "
@@ -54,6 +54,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in [only] if only else command_names():
         importlib.import_module(f"station.commands.{name}").add_parser(subparsers)
+    if only:
+        parser.help_hint = f"station {only}"
     return parser
 
 

@@ -6,6 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from station.commands._parser import output_name
 from station.errors import StationError
 
 
@@ -29,7 +30,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--csv", action="store_true", required=True, help="CSV output (the only format for now)"
     )
     parser.add_argument(
-        "-o", "--output", metavar="OUT", help="write to OUT instead of standard output"
+        "-o",
+        "--output",
+        metavar="OUT",
+        type=output_name,
+        help="write to OUT instead of standard output",
     )
     parser.add_argument(
         "--layout",
