@@ -37,12 +37,12 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     Registering one command imports only its module: the TUI and each command start without
     loading the others (``station --help`` and a mistyped command still see them all).
     """
-    import argparse
     import importlib
 
     from station import __version__
+    from station.commands._parser import OneLineParser
 
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="station",
         description=(
             "Acquisition station for robot calibration: repeatability, relative accuracy and "
@@ -54,23 +54,56 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in [only] if only else command_names():
         importlib.import_module(f"station.commands.{name}").add_parser(subparsers)
+    if only:
+        parser.help_hint = f"station {only}"
     return parser
 
 
 _TOP_LEVEL_FLAGS = ("-h", "--help", "--version")
 
 
+_SIGNAL_KEEPING_COMMANDS = ("capture",)
+"""Commands whose exit code says a stop signal came (128 + the signal), from the first
+instruction to the last: they take the signals before their module loads."""
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``station`` console script; returns the process exit code."""
+    arguments = sys.argv[1:] if argv is None else argv
+    keeps_signals = bool(arguments) and arguments[0] in _SIGNAL_KEEPING_COMMANDS
+    if keeps_signals:
+        from station.commands._signals import keep_stop_signals
+
+        keep_stop_signals()
     try:
         return _main(argv)
     except KeyboardInterrupt:
         # Ctrl-C while the command is still loading (before its own handling starts).
-        try:  # noqa: SIM105 (contextlib would be one more import in the window)
-            print("station: interrupted", file=sys.stderr)
-        except (OSError, ValueError):
-            pass
+        _say("station: interrupted")
         return 130
+    except BaseException as error:
+        if not keeps_signals:
+            raise
+        from station.commands._signals import StoppedBySignal
+
+        if not isinstance(error, StoppedBySignal):
+            raise
+        _say(f"station: {error.name}: stopped before anything was written")
+        return 128 + error.signum
+    finally:
+        if keeps_signals and argv is not None:
+            # Run in-process (the tests): give the signals back. The process's own command
+            # keeps them to its exit, so a signal in its last instructions is not a raw kill.
+            from station.commands._signals import release_stop_signals
+
+            release_stop_signals()
+
+
+def _say(line: str) -> None:
+    try:  # noqa: SIM105 (contextlib would be one more import in the window)
+        print(line, file=sys.stderr)
+    except (OSError, ValueError):
+        pass
 
 
 def _main(argv: Sequence[str] | None) -> int:

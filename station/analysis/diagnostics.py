@@ -27,6 +27,7 @@ Definitions and sources: ``reference/spc-extensions.md`` §3–§5.
 from __future__ import annotations
 
 import math
+import threading
 import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -499,10 +500,20 @@ def drift(
     return Drift(chart, found, message)
 
 
+_SCIPY_IMPORT = threading.Lock()
+"""One importer of scipy at a time: two threads importing its packages at once can deadlock
+on Python's module locks (scipy.stats and scipy.special import each other's parts), which
+under load ended ``station capture`` with exit 70."""
+
+
 def import_scipy() -> None:
     """Import the parts of scipy the analysis loads where it uses them (a screen that imports
-    the analysis does not wait for scipy): call it on a worker thread early, so that the first
-    use does not import it where waiting costs (an engine's intake, under its lock)."""
-    import scipy.signal  # noqa: F401 - the EWMA (diagnostics)
-    import scipy.special  # noqa: F401 - the confidence bounds (capability, constants, hints)
-    import scipy.stats  # noqa: F401 - the tests (diagnostics, gauge check, joints)
+    the analysis does not wait for scipy), once: a second caller waits for the first.
+
+    Call it before starting the threads that analyse (the engine does, as it starts), or early
+    on one worker thread (the TUI's warm-up), so that no analysis imports scipy where waiting
+    costs (an engine's intake, under its lock) or alongside another importer."""
+    with _SCIPY_IMPORT:
+        import scipy.signal  # noqa: F401 - the EWMA (diagnostics)
+        import scipy.special  # noqa: F401 - the confidence bounds (capability, constants, hints)
+        import scipy.stats  # noqa: F401 - the tests (diagnostics, gauge check, joints)

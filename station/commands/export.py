@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from station.commands._parser import output_name
+
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register ``station export``."""
@@ -27,7 +29,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--csv", action="store_true", required=True, help="CSV output (the only format for now)"
     )
     parser.add_argument(
-        "-o", "--output", metavar="OUT", help="write to OUT instead of standard output"
+        "-o",
+        "--output",
+        metavar="OUT",
+        type=output_name,
+        help="write to OUT instead of standard output",
     )
     parser.add_argument(
         "--layout",

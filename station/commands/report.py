@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from station.commands._parser import output_name
+
 FORMATS = ("txt", "md", "html")
 
 
@@ -27,7 +29,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("file", metavar="FILE", help="the session file (.jsonl)")
     parser.add_argument("--format", choices=FORMATS, default=None, help="txt (default), md or html")
     parser.add_argument(
-        "-o", "--output", metavar="OUT", help="write to OUT instead of standard output"
+        "-o",
+        "--output",
+        metavar="OUT",
+        type=output_name,
+        help="write to OUT instead of standard output",
     )
     parser.add_argument("--force", action="store_true", help="overwrite OUT when it exists")
     parser.set_defaults(func=run)

@@ -20,7 +20,6 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import os
 import re
 from collections.abc import Mapping
 from datetime import UTC, datetime
@@ -29,17 +28,22 @@ from typing import Any
 
 from station.errors import StationError
 from station.record.source import AnalysedSession, analyse_session
-from station.session.durable import make_folders, write_text_durably
+from station.session.durable import (
+    data_home,
+    make_folders,
+    refuse_links_below,
+    write_text_durably,
+)
 
 FORMAT = "station-baseline/1"
 _UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
 
 
 def baselines_folder(environ: Mapping[str, str] | None = None) -> Path:
-    """Where baselines live: ``$XDG_DATA_HOME/station/baselines``."""
-    environ = os.environ if environ is None else environ
-    data_home = environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share")
-    return Path(data_home) / "station" / "baselines"
+    """Where baselines live: ``$XDG_DATA_HOME/station/baselines``; StationError when a level
+    of it below ``$XDG_DATA_HOME`` is a symbolic link."""
+    home = data_home(environ)
+    return refuse_links_below(home, home / "station" / "baselines", "the baselines")
 
 
 def baseline_path(robot: str, folder: Path | None = None) -> Path:

@@ -36,14 +36,15 @@ class InstrumentIntake:
         """Start the intake thread, subscribe to the gauges' sets and port changes (cancelled
         by :meth:`_close`) and record how each line stands now. On failure everything is undone
         and the file closed."""
+        # scipy loads here, on the thread that starts the session and before the threads that
+        # analyse start: not on the intake under the lock when the live limits freeze
+        # mid-session, and never on two threads at once (that deadlocked under load).
+        import_scipy()
         self._intake = queue.SimpleQueue()
         self._intake_thread = threading.Thread(
             target=self._take_in, name="runner intake", daemon=True
         )
         self._intake_thread.start()
-        # scipy loads where the analysis first uses it: here on a thread of its own, early,
-        # rather than on the intake under the lock when the live limits freeze mid-session.
-        threading.Thread(target=import_scipy, name="runner warm-up", daemon=True).start()
         self._start_analysis_thread()
         try:
             for reader in getattr(self.gauges, "readers", ()):

@@ -12,7 +12,7 @@ import errno
 import os
 import secrets
 import stat
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TextIO, TypeVar
 
@@ -35,6 +35,45 @@ def fsync_folder(folder: Path) -> None:
             os.fsync(fd)
     finally:
         os.close(fd)
+
+
+def data_home(environ: Mapping[str, str] | None = None) -> Path:
+    """``$XDG_DATA_HOME`` (``~/.local/share`` when unset): the user's folder, which holds the
+    station's own ``station/`` data folder (sessions, baselines, the gauge register)."""
+    environ = os.environ if environ is None else environ
+    return Path(environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share"))
+
+
+def refuse_links_below(base: Path, path: Path, what: str) -> Path:
+    """``path`` when no level of it below ``base`` is a symbolic link; else a StationError
+    naming the link and ``what`` it leads to.
+
+    ``base`` is the user's own folder (``$XDG_DATA_HOME``, ``$XDG_CONFIG_HOME``); the levels
+    below it are the station's, which it creates itself and never reads or writes through a link
+    (a link there would send a baseline, the gauge register or a session somewhere else, or make
+    a register in an empty folder read as "no gauges recorded yet"). Levels that do not exist
+    yet are no link.
+    """
+    try:
+        below = Path(path).relative_to(base)
+    except ValueError:
+        return path
+    level = Path(base)
+    for part in below.parts:
+        level = level / part
+        try:
+            info = os.lstat(level)
+        except FileNotFoundError:
+            break
+        except OSError as error:
+            raise StationError(f"cannot read {level}: {error.strerror}") from None
+        if stat.S_ISLNK(info.st_mode):
+            raise StationError(
+                f"{level} is a symbolic link, refused for {what}: station does not read or "
+                "write its data through links; replace the link with a folder (or the file) "
+                "itself"
+            )
+    return path
 
 
 def make_folders(folder: Path) -> None:

@@ -44,7 +44,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from station.errors import StationError
-from station.session.durable import make_folders, write_text_durably
+from station.session.durable import (
+    data_home,
+    make_folders,
+    refuse_links_below,
+    write_text_durably,
+)
 
 if TYPE_CHECKING:
     from station.analysis.gauge_check import GaugeCheck
@@ -60,12 +65,13 @@ State = Literal["passed", "failed", "overdue", "none"]
 
 
 def register_path(environ: Mapping[str, str] | None = None) -> Path:
-    """The register file: ``STATION_GAUGES``, else ``$XDG_DATA_HOME/station/gauges.json``."""
+    """The register file: ``STATION_GAUGES``, else ``$XDG_DATA_HOME/station/gauges.json``
+    (StationError when a level of it below ``$XDG_DATA_HOME`` is a symbolic link)."""
     environ = os.environ if environ is None else environ
     if environ.get(REGISTER_ENV):
         return Path(environ[REGISTER_ENV])
-    data_home = environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share")
-    return Path(data_home) / "station" / "gauges.json"
+    home = data_home(environ)
+    return refuse_links_below(home, home / "station" / "gauges.json", "the gauge register")
 
 
 def parse_date(text: str | dt.date, what: str = "date") -> dt.date:

@@ -26,6 +26,7 @@ import tomllib
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
+from station.errors import StationError
 from station.session.durable import make_folders, write_text_durably
 from station.session.signing import config_folder
 
@@ -58,7 +59,10 @@ def settings_path() -> Path:
 def load_remembered(path: Path | None = None) -> tuple[RememberedSetup, str]:
     """The remembered set-up and, when the file could not be read, a sentence saying why
     (the set-up is then empty). A missing file is no fault."""
-    path = path or settings_path()
+    try:
+        path = path or settings_path()
+    except StationError as error:
+        return RememberedSetup(), f"{error.message}; nothing was pre-filled"
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:

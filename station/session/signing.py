@@ -35,6 +35,7 @@ from cryptography.hazmat.primitives import serialization
 from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey, Ed25519PublicKey
 
 from station.errors import StationError
+from station.session.durable import refuse_links_below
 
 KEY_FILE_NAME = "signing-key.pem"
 SIGNATURE_CONTEXT = b"station-finish/1"
@@ -47,9 +48,10 @@ later ones write names its ``signer`` in the header and signs its finish; a head
 
 
 def config_folder() -> Path:
-    """``$XDG_CONFIG_HOME/station`` (``~/.config/station`` when the variable is unset)."""
-    base = os.environ.get("XDG_CONFIG_HOME") or str(Path.home() / ".config")
-    return Path(base) / "station"
+    """``$XDG_CONFIG_HOME/station`` (``~/.config/station`` when the variable is unset);
+    StationError when it is a symbolic link."""
+    base = Path(os.environ.get("XDG_CONFIG_HOME") or str(Path.home() / ".config"))
+    return refuse_links_below(base, base / "station", "the station's settings and signing key")
 
 
 def predates_signing(header: Mapping[str, Any]) -> bool:

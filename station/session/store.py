@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from station.errors import StationError
+from station.session.durable import data_home, refuse_links_below
 from station.session.model import Session, load_session
 from station.session.replay import Status
 
@@ -27,7 +28,8 @@ def sessions_folder(
 
     In order: ``explicit`` (``--sessions DIR``), ``STATION_SESSIONS``, ``./sessions`` when the
     working directory has one, else ``$XDG_DATA_HOME/station/sessions`` (by default
-    ``~/.local/share/station/sessions``). The folder is not created here; the writer creates it.
+    ``~/.local/share/station/sessions``; StationError when a level of it below
+    ``$XDG_DATA_HOME`` is a symbolic link). The folder is not created here; the writer creates it.
     """
     environ = os.environ if environ is None else environ
     if explicit is not None and not str(explicit).strip():
@@ -39,8 +41,9 @@ def sessions_folder(
     local = (cwd or Path.cwd()) / "sessions"
     if local.is_dir():
         return local, "the working directory's sessions folder"
-    data_home = environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share")
-    return Path(data_home) / "station" / "sessions", "the user's data folder"
+    home = data_home(environ)
+    folder = refuse_links_below(home, home / "station" / "sessions", "the sessions folder")
+    return folder, "the user's data folder"
 
 
 @dataclass(frozen=True)

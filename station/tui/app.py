@@ -616,8 +616,9 @@ class StationApp(App[int]):
 
 
 def _import_analysis() -> None:
-    """What the first live analysis would otherwise import on the UI thread."""
-    import scipy.special  # noqa: F401 - capability's confidence bound
-    import scipy.stats  # noqa: F401 - the hints' tests
+    """What the first live analysis would otherwise import on the UI thread (scipy through
+    the one importer the engine waits on too)."""
+    from station.analysis.diagnostics import import_scipy
 
+    import_scipy()
     import station.analysis.summary  # noqa: F401

@@ -51,7 +51,9 @@ Exit codes: 0 finished; 2 a one-line error (bad option, no port, a failed write 
 disk, no complete reading set after ``--attempts`` tries); 70 the command itself failed (a bug:
 the session is interrupted and resumable, the line says where); 128 + the signal number after
 SIGHUP (129), SIGINT (130) or SIGTERM (143): an ``interrupted`` event is written and the session
-is resumable with ``--resume FILE``.
+is resumable with ``--resume FILE``. The signals are taken from the command's first instruction
+to its exit (``station.commands._signals``): before the session starts a signal stops it with
+nothing written; once it is finished the summary is printed whole, then the exit code.
 
 The command's pieces: ``options`` (the set-up from the options, new or resumed, and the pace),
 ``inputs`` (``--input``/``--inputs`` values), ``walker`` (the walk on a worker thread: the

@@ -9,16 +9,17 @@ import contextlib
 import signal
 import sys
 import threading
+import time
 from typing import Any
 
 from station.commands._args import positive_number
+from station.commands._signals import keep_stop_signals
 from station.commands.capture.inputs import check_answerable, parse_inputs
 from station.commands.capture.options import new_setup, pacing, resumed_setup
 from station.commands.capture.output import Printer, acknowledge_at_terminal, print_summary
 from station.commands.capture.walker import BY, Headless
 from station.errors import StationError
 
-_SIGNALS = ("SIGHUP", "SIGINT", "SIGTERM")
 CRASH_EXIT = 70
 """The exit code when the command itself fails (EX_SOFTWARE): a bug, not the user's input."""
 
@@ -87,15 +88,18 @@ def run(args: argparse.Namespace) -> int:
     check_answerable(plan_steps(setup), setup.procedure, inputs, done)
     every, enter = pacing(setup.trigger, args.every)
 
-    caught: list[int] = []
-    previous = {}
-    for name in _SIGNALS:
-        signum = getattr(signal, name)
-        previous[signum] = signal.signal(signum, lambda number, frame: caught.append(number))
+    # Taken since the process started (station.cli); from here on a signal is recorded and
+    # acted on where it is safe, to the end of the process: the summary is never cut short.
+    stop_signals = keep_stop_signals()
+    stop_signals.hold()
+    caught = stop_signals.caught
     gauges = None
     try:
         gauges = open_gauges(setup)
-        if not gauges.wait_connected(timeout):
+        connected = _connected(gauges, timeout, caught)
+        if caught:
+            return _stopped_before_start(caught[0])
+        if not connected:
             problems = "; ".join(
                 f"{r.url}: {r.last_message or r.state}"
                 for r in gauges.readers
@@ -104,7 +108,7 @@ def run(args: argparse.Namespace) -> int:
             raise StationError(f"the gauges did not connect within {timeout:g} s ({problems})")
         _check_frames(gauges, setup, timeout, args.resume)
         if caught:
-            return 128 + caught[0]  # before any session exists: nothing to record
+            return _stopped_before_start(caught[0])
         printer = Printer(setup.resolved_resolution)
         if args.resume:
             runner = Runner.resume(args.resume, gauges, setup=setup, listener=printer, by=BY)
@@ -151,10 +155,31 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if gauges is not None:
             gauges.stop()
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
     print_summary(runner, analysis)
+    if caught:
+        name = signal.Signals(caught[0]).name
+        print(f"station: {name} after the session finished; it is complete", file=sys.stderr)
+        return 128 + caught[0]
     return 0
+
+
+def _stopped_before_start(signum: int) -> int:
+    """One line and the exit code for a signal before any session exists: nothing to record."""
+    name = signal.Signals(signum).name
+    print(f"station: {name}: stopped before the session started", file=sys.stderr)
+    return 128 + signum
+
+
+def _connected(gauges: Any, timeout: float, caught: list[int]) -> bool:
+    """Wait up to ``timeout`` for every gauge to connect; False at once when a signal came."""
+    deadline = time.monotonic() + timeout
+    while not caught:
+        remaining = deadline - time.monotonic()
+        if gauges.wait_connected(max(0.0, min(remaining, 0.1))):
+            return True
+        if remaining <= 0:
+            return False
+    return False
 
 
 def _ended(runner: Any, headless: Headless) -> int | None:

@@ -1,8 +1,9 @@
 """The home screen: what this program does, and the choices: resume, new session, review, quit.
 
 An unfinished session is offered first, so after an SSH drop the operator presses Enter and is
-back where they were. The sessions folder in use is said on screen, and in ``station demo`` a
-banner says that the indicators are simulated.
+back where they were; past :data:`RESUME_OFFERED` of them the rest are one line (Enter lists
+them), so New session is always in reach. The sessions folder in use is said on screen, and in
+``station demo`` a banner says that the indicators are simulated.
 """
 
 from __future__ import annotations
@@ -33,6 +34,11 @@ INTRODUCTION = (
 )
 
 
+RESUME_OFFERED = 5
+"""Unfinished sessions offered on the home screen before the rest are summed up in one line:
+with hundreds of them, New session would be screens away."""
+
+
 class HomeScreen(Screen[None]):
     """Resume, new session per procedure, review, quit."""
 
@@ -51,6 +57,7 @@ class HomeScreen(Screen[None]):
         self._unfinished: list[Any] = []
         self._session_count = 0
         self._load_error = ""
+        self._all_unfinished_shown = False
 
     def compose(self) -> ComposeResult:
         """Title, introduction, the choices, where the sessions go."""
@@ -84,9 +91,21 @@ class HomeScreen(Screen[None]):
             self._load_error = explained(error)
         choices = self.query_one("#home-choices", OptionList)
         choices.clear_options()
-        for index, summary in enumerate(self._unfinished):
+        offered = len(self._unfinished)
+        if not self._all_unfinished_shown:
+            offered = min(offered, RESUME_OFFERED)
+        for index, summary in enumerate(self._unfinished[:offered]):
             choices.add_option(
                 Option(shown(_resume_label(summary), limit=300), id=f"resume:{index}")
+            )
+        if offered < len(self._unfinished):
+            more = len(self._unfinished) - offered
+            choices.add_option(
+                Option(
+                    f"… {more} older unfinished session{'s' if more != 1 else ''} "
+                    "(Enter lists them all here)",
+                    id="more-unfinished",
+                )
             )
         choices.add_option(
             Option("New session (choose the procedure, robot, limits and port)", id="new")
@@ -115,6 +134,9 @@ class HomeScreen(Screen[None]):
         choice = event.option.id or ""
         if choice.startswith("resume:"):
             self.open_resume(self._unfinished[int(choice.split(":", 1)[1])])
+        elif choice == "more-unfinished":
+            self._all_unfinished_shown = True
+            self.reload()
         elif choice == "new":
             self.action_new()
         elif choice.startswith("demo:"):
