@@ -92,11 +92,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 128 + error.signum
     finally:
         if keeps_signals and argv is not None:
-            # Run in-process (the tests): give the signals back. The process's own command
-            # keeps them to its exit, so a signal in its last instructions is not a raw kill.
+            # Run in-process (the tests): give the signals back.
             from station.commands._signals import release_stop_signals
 
             release_stop_signals()
+        elif keeps_signals:
+            # The process's own command keeps them to its exit, so a signal in its last
+            # instructions (the interpreter's shutdown included) is not a raw kill.
+            from station.commands._signals import ignore_stop_signals_to_exit
+
+            ignore_stop_signals_to_exit()
 
 
 def _say(line: str) -> None:

@@ -72,6 +72,14 @@ def keep_stop_signals() -> StopSignals:
     return _taken
 
 
+def ignore_stop_signals_to_exit() -> None:
+    """The command is over: a stop signal from now on has nothing left to stop. Ignored, as
+    the interpreter's shutdown would otherwise put back the default action (a raw kill by
+    SIGTERM in the last instructions, after the summary was printed whole)."""
+    for signum in STOP_SIGNALS:
+        signal.signal(signum, signal.SIG_IGN)
+
+
 def release_stop_signals() -> None:
     """Give the stop signals back (a command run in-process, as the tests do, is over)."""
     global _taken
