@@ -92,6 +92,9 @@ class RobotHistory:
     trends: tuple[Trend, ...] = field(default_factory=tuple)
     baseline_session: str | None = None
     unit: str = ""
+    skipped: tuple[tuple[Path, str], ...] = ()
+    """The session files of the folder that could not be read, each with why (whose robot
+    they are is unknown, or their analysis failed): left out, and said so one line each."""
 
 
 def _entry(path: Path, baseline_session: str | None) -> HistoryEntry:
@@ -220,10 +223,12 @@ def _trends(entries: Sequence[HistoryEntry], unit: str) -> tuple[Trend, ...]:
 
 def robot_history(folder: str | Path, robot: str) -> RobotHistory:
     """Every session of ``robot`` (exact name) in ``folder``, oldest first, with the trends.
-    Files that do not load are left out (``station verify`` names them). StationError when
+    Files that do not load are left out and listed in ``skipped`` with why. StationError when
     the robot has no session there."""
     folder = Path(folder)
-    summaries = [s for s in list_sessions(folder) if s.error is None and s.robot == robot]
+    listed = list_sessions(folder)
+    skipped = [(s.path, s.error) for s in listed if s.error is not None]
+    summaries = [s for s in listed if s.error is None and s.robot == robot]
     if not summaries:
         raise StationError(f"no session of robot {robot!r} in {folder}; check the name.")
     try:
@@ -236,8 +241,8 @@ def robot_history(folder: str | Path, robot: str) -> RobotHistory:
     for summary in summaries:
         try:
             entries.append(_entry(summary.path, baseline_session))
-        except StationError:
-            continue
+        except StationError as error:
+            skipped.append((summary.path, error.message))
     unit = entries[-1].unit if entries else ""
     return RobotHistory(
         robot=robot,
@@ -246,6 +251,7 @@ def robot_history(folder: str | Path, robot: str) -> RobotHistory:
         trends=_trends(entries, unit),
         baseline_session=baseline_session,
         unit=unit,
+        skipped=tuple(sorted(skipped)),
     )
 
 
@@ -283,6 +289,7 @@ def history_json(history: RobotHistory) -> dict[str, Any]:
         "folder": str(history.folder),
         "unit": history.unit,
         "baseline_session": history.baseline_session,
+        "skipped": [{"file": path.name, "error": why} for path, why in history.skipped],
         "sessions": [
             {
                 "file": e.path.name,
@@ -360,4 +367,7 @@ def format_history(history: RobotHistory) -> list[str]:
     if history.trends:
         lines += ["", f"Wear trend ({history.trends[0].procedure} sessions):"]
         lines += [f"  {plain(t.sentence)}" for t in history.trends]
+    if history.skipped:
+        lines += ["", f"Left out ({len(history.skipped)} files that could not be read):"]
+        lines += [f"  {plain(path.name)}: {plain(why)}" for path, why in history.skipped]
     return lines

@@ -159,3 +159,33 @@ def test_a_link_planted_beside_the_baseline_neither_blocks_nor_receives_it(sessi
     assert baseline_for("R1")["robot"] == "R1"
     assert path.is_file() and not path.is_symlink()
     assert victim.read_text() == "precious\n" and planted.is_symlink()
+
+
+def test_history_names_each_file_it_could_not_read_in_one_line(sessions, capsys):
+    """Issue 27, finding 9: a folder with corrupt files among a robot's sessions. The history
+    is the readable sessions; each corrupt file is one line saying why, in the text and the
+    JSON, never left out silently."""
+    paths = five_sessions(sessions)
+    (sessions / "garbage.jsonl").write_bytes(b"\x00\xffnot a session\n" * 50)
+    torn = sessions / "cut-in-its-header.jsonl"
+    torn.write_bytes(paths[0].read_bytes()[:40])
+    (sessions / "empty.jsonl").write_bytes(b"")
+
+    assert main(["history", "KSC-7", "--sessions", str(sessions)]) == 0
+    out = capsys.readouterr().out
+    assert "History of robot KSC-7 (5 sessions)" in out
+    assert "Left out (3 files that could not be read):" in out
+    lines = {line.split(":")[0].strip(): line for line in out.splitlines() if ".jsonl:" in line}
+    assert set(lines) >= {"garbage.jsonl", "cut-in-its-header.jsonl", "empty.jsonl"}
+    for name in ("garbage.jsonl", "cut-in-its-header.jsonl", "empty.jsonl"):
+        assert len(lines[name].split(": ", 1)[1]) > 10, lines[name]  # a reason, not a bare name
+
+    assert main(["history", "KSC-7", "--sessions", str(sessions), "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    assert sorted(s["file"] for s in document["skipped"]) == [
+        "cut-in-its-header.jsonl",
+        "empty.jsonl",
+        "garbage.jsonl",
+    ]
+    assert all(s["error"] for s in document["skipped"])
+    assert len(document["sessions"]) == 5
