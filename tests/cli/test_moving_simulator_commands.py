@@ -33,12 +33,13 @@ def test_read_prints_one_set_per_round_trip_and_what_the_frames_say() -> None:
     model = FixtureModel(dict.fromkeys("xyz", AxisModel(noise=0.01)), GaugeSpec(0.001))
     rests = [{c: model.value(c, k, 9) for c in "xyz"} for k in range(40)]
     sets = [{line["channel"]: line["value"] for line in lines[i : i + 3]} for i in (0, 3)]
-    # Two consecutive rest positions (within the count the settling swing may leave).
+    # Two rest positions, one per round trip (within the count the settling swing may leave):
+    # the next one, or a later one where a loaded machine starved the reader through a trip.
     found = [
         next(k for k, rest in enumerate(rests) if all(abs(s[c] - rest[c]) < 0.0011 for c in s))
         for s in sets
     ]
-    assert found[1] == found[0] + 1
+    assert found[0] < found[1] <= found[0] + 3, found
     assert "station: the robot left the fixture" in result.stderr
     assert "station: x, y, z send steps of 0.001, which is mm on this protocol" in result.stderr
     assert "station: x sends" not in result.stderr  # one line once every channel has spoken
