@@ -193,6 +193,8 @@ def test_figures() -> None:
     assert overall_verdict(["CAPABLE", "NOT CAPABLE"]) == "NOT CAPABLE"
     assert overall_verdict(["CAPABLE", "CAPABLE"]) == "CAPABLE"
     assert overall_verdict(["CAPABLE", "UNDEFINED"]) == "UNDEFINED"
+    assert overall_verdict(["CAPABLE", "INCONCLUSIVE"]) == "INCONCLUSIVE"
+    assert overall_verdict(["INCONCLUSIVE", "NOT CAPABLE"]) == "NOT CAPABLE"
 
 
 def test_stats_table_flags_out_of_spec_and_says_provisional() -> None:
