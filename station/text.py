@@ -90,11 +90,13 @@ def format_index(value: float | None) -> str:
 # -- verdict words ----------------------------------------------------------------------------
 
 CAPABLE, NOT_CAPABLE, UNDEFINED = "CAPABLE", "NOT CAPABLE", "UNDEFINED"
+INCONCLUSIVE = "INCONCLUSIVE"
 
 
 def verdict_word(capability: Any) -> str:
-    """CAPABLE, NOT CAPABLE or UNDEFINED from ``capability.capable`` (True, False, None): the
-    verdict is always a word, never only a colour."""
+    """The report's point-estimate rule as a word: CAPABLE, NOT CAPABLE or UNDEFINED from
+    ``capability.capable`` (True, False, None). A channel's verdict, which weighs the confidence
+    bounds too, is :func:`judged_word`; this is only its fallback for an analysis without one."""
     capable = getattr(capability, "capable", None) if capability is not None else None
     if capable is True:
         return CAPABLE
@@ -104,7 +106,8 @@ def verdict_word(capability: Any) -> str:
 
 
 def overall_verdict(words: Iterable[str]) -> str:
-    """The session's verdict: NOT CAPABLE if any axis is, CAPABLE if all are, else UNDEFINED."""
+    """The session's verdict: NOT CAPABLE if any axis is, CAPABLE if all are, INCONCLUSIVE if
+    any is (and none is NOT CAPABLE), else UNDEFINED."""
     words = list(words)
     if not words:
         return UNDEFINED
@@ -112,6 +115,8 @@ def overall_verdict(words: Iterable[str]) -> str:
         return NOT_CAPABLE
     if all(word == CAPABLE for word in words):
         return CAPABLE
+    if INCONCLUSIVE in words:
+        return INCONCLUSIVE
     return UNDEFINED
 
 

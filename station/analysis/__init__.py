@@ -11,6 +11,8 @@ from station.analysis.capability import (
     capability,
     cp_interval,
     cpk_lower_bound,
+    cpk_upper_bound,
+    readings_needed,
 )
 from station.analysis.charts import (
     CHART_TYPES,
@@ -56,6 +58,7 @@ __all__ = [
     "control_chart",
     "cp_interval",
     "cpk_lower_bound",
+    "cpk_upper_bound",
     "d2",
     "d3",
     "describe",
@@ -64,6 +67,7 @@ __all__ = [
     "modes_at_resolution",
     "moving_ranges",
     "pooled_sigma",
+    "readings_needed",
     "rule_descriptions",
     "sigma_within",
     "subgroups",

@@ -10,9 +10,13 @@ The report's indices use the overall sample sigma s (n - 1) of every reading:
 R-bar/d2 or S-bar/c4 for subgroups; qcc's and Minitab's Cp/Cpk). With one limit only, Cp is
 undefined and Cpk is the index of the side that exists.
 
-``cpk_lower`` is the one-sided lower confidence bound on the (overall) Cpk by Bissell's (1990)
-normal approximation, Cpk - z * sqrt(1/(9n) + Cpk^2/(2(n-1))): with 30 readings a Cpk of 1.17
-is only known to be above about 0.87 with 95 % confidence.
+``cpk_lower`` and ``cpk_upper`` are the one-sided confidence bounds on the (overall) Cpk by
+Bissell's (1990) normal approximation, Cpk -+ z * sqrt(1/(9n) + Cpk^2/(2(n-1))) with z the
+``confidence`` quantile: with 30 readings Table 2-1's Cpk of 1.17 is only known to be above 0.90
+with 95 % confidence. ``cpk_ci`` is Bissell's two-sided interval and ``cp_ci`` the chi-square
+interval on Cp, both at ``confidence``. :func:`readings_needed` says how many readings the bound
+needs to settle a verdict at the observed Cpk. The capability verdict built on these bounds is
+in :mod:`station.analysis.verdict`.
 
 Nothing here returns inf or NaN: with fewer than 2 readings or a sigma of 0 the indices are
 ``None`` and ``message`` says why.
@@ -83,11 +87,13 @@ class SpecLimits:
 class Capability:
     """Capability indices of one channel; see the module docstring for the definitions.
 
-    ``cp`` .. ``cpk`` and ``cpk_lower`` use ``sigma`` (overall, n - 1); ``cp_within`` and
-    ``cpk_within`` use ``sigma_within``. ``capable`` is ``cpk >= threshold`` (``None`` when Cpk
-    is undefined, and then ``message`` says why). ``above_usl``/``below_lsl`` count readings
-    strictly outside the limits. ``n`` and ``mean`` are the readings' count and mean;
-    ``confidence`` is the level of ``cpk_lower``.
+    ``cp`` .. ``cpk`` and their bounds use ``sigma`` (overall, n - 1); ``cp_within`` and
+    ``cpk_within`` use ``sigma_within``. ``capable`` is the report's point-estimate rule
+    ``cpk >= threshold`` (``None`` when Cpk is undefined, and then ``message`` says why); the
+    verdict that weighs the bounds is :func:`station.analysis.verdict.judge_verdict`'s.
+    ``above_usl``/``below_lsl`` count readings strictly outside the limits. ``n`` and ``mean``
+    are the readings' count and mean; ``confidence`` is the level of ``cpk_lower`` and
+    ``cpk_upper`` (each one-sided) and of ``cp_ci`` and ``cpk_ci`` (two-sided, Bissell's for Cpk).
     """
 
     lsl: float | None
@@ -109,10 +115,17 @@ class Capability:
     n: int = 0
     mean: float | None = None
     confidence: float = 0.95
+    cpk_upper: float | None = None
+    cp_ci: tuple[float, float] | None = None
+    cpk_ci: tuple[float, float] | None = None
 
 
 def _finite_or_none(value: float | None) -> float | None:
     return value if value is not None and math.isfinite(value) else None
+
+
+def _finite_pair(pair: tuple[float, float]) -> tuple[float, float] | None:
+    return pair if all(math.isfinite(v) for v in pair) else None
 
 
 def capability_indices(
@@ -172,6 +185,45 @@ def cpk_lower_bound(cpk: float, n: int, confidence: float = 0.95) -> float:
     return cpk - _bissell_half_width(cpk, n, normal_quantile(_check_confidence(confidence)))
 
 
+def cpk_upper_bound(cpk: float, n: int, confidence: float = 0.95) -> float:
+    """One-sided upper confidence bound on Cpk (Bissell), z the ``confidence`` normal quantile."""
+    return cpk + _bissell_half_width(cpk, n, normal_quantile(_check_confidence(confidence)))
+
+
+#: Beyond this many readings :func:`readings_needed` gives up (a Cpk a hair off the threshold).
+MOST_READINGS_NEEDED = 10**9
+
+
+def readings_needed(cpk: float, threshold: float, confidence: float = 0.95) -> int | None:
+    """The fewest readings at which Bissell's one-sided bound at ``confidence`` settles the
+    verdict if the Cpk stays at ``cpk``: the lower bound reaching ``threshold`` (``cpk`` above
+    it), or the upper bound falling below it (``cpk`` below). ``None`` when ``cpk`` equals the
+    threshold or more than ``MOST_READINGS_NEEDED`` would be needed.
+
+    Table 2-1 (Cpk 1.167 from 30 readings, threshold 1, 95 %) needs 77.
+    """
+    z = normal_quantile(_check_confidence(confidence))
+    margin = abs(cpk - threshold)
+    if not margin > 0:
+        return None
+
+    def settles(n: int) -> bool:
+        # The lower bound must reach the threshold (>=); the upper must fall below it (<).
+        half_width = _bissell_half_width(cpk, n, z)
+        return half_width <= margin if cpk > threshold else half_width < margin
+
+    # The half-width shrinks as n grows: double to an n that settles, then bisect.
+    low, high = 1, 2
+    while not settles(high):
+        low, high = high, high * 2
+        if low > MOST_READINGS_NEEDED:
+            return None
+    while high - low > 1:
+        middle = (low + high) // 2
+        low, high = (low, middle) if settles(middle) else (middle, high)
+    return high if high <= MOST_READINGS_NEEDED else None
+
+
 def normal_quantile(p: float) -> float:
     """The standard normal quantile (the standard library's, Wichura's AS 241 to double
     precision: the same figure as scipy's ndtri, without loading scipy.special)."""
@@ -191,7 +243,7 @@ def capability(
 
     ``subgroup`` picks the within-sigma estimator (as the control chart does). ``sigma_within``
     overrides it with a known value, e.g. the sigma of a phase-I chart or a pooled sigma.
-    ``confidence`` is the level of the one-sided ``cpk_lower`` bound.
+    ``confidence`` is the level of the one-sided bounds and of the two-sided intervals.
     """
     if not isinstance(limits, SpecLimits):
         raise TypeError("limits must be a SpecLimits")
@@ -237,9 +289,13 @@ def capability(
     )
     if cpk is None and not reasons:
         reasons.append(f"the indices are too large to represent (sigma {sigma:g})")
-    cpk_lower = None
+    cpk_lower = cpk_upper = cp_ci = cpk_ci = None
     if cpk is not None:
         cpk_lower = _finite_or_none(cpk_lower_bound(cpk, n, confidence))
+        cpk_upper = _finite_or_none(cpk_upper_bound(cpk, n, confidence))
+        cpk_ci = _finite_pair(bissell_interval(cpk, n, confidence))
+    if cp is not None:
+        cp_ci = _finite_pair(cp_interval(cp, n, confidence))
     return Capability(
         lsl=lsl,
         usl=usl,
@@ -260,4 +316,7 @@ def capability(
         n=n,
         mean=mean,
         confidence=float(confidence),
+        cpk_upper=cpk_upper,
+        cp_ci=cp_ci,
+        cpk_ci=cpk_ci,
     )

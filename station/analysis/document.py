@@ -18,6 +18,7 @@ if TYPE_CHECKING:
     )
     from station.analysis.spatial import Spatial
     from station.analysis.summary import Analysis, ChannelAnalysis
+    from station.analysis.verdict import Verdict
 
 
 def json_number(value: float | None) -> float | None:
@@ -53,6 +54,10 @@ def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
             "cpl": json_number(cap.cpl),
             "cpk": json_number(cap.cpk),
             "cpk_lower": json_number(cap.cpk_lower),
+            "cpk_upper": json_number(cap.cpk_upper),
+            "cp_ci": _json_pair(cap.cp_ci),
+            "cpk_ci": _json_pair(cap.cpk_ci),
+            "confidence": cap.confidence,
             "cp_within": json_number(cap.cp_within),
             "cpk_within": json_number(cap.cpk_within),
             "sigma": json_number(cap.sigma),
@@ -66,6 +71,7 @@ def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
             "min_n": verdict.min_n if verdict else None,
             "verdict": verdict.label if verdict else None,
             "verdict_text": verdict.text if verdict else None,
+            "decision": _decision_json(verdict),
             "method": channel.capability_method,
             "percentile": _percentile_json(channel.percentile),
         },
@@ -97,6 +103,24 @@ def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
             "message": chart.message,
         },
         "alarms": [_alarm_json(a, channel.alarm_is_live(a)) for a in channel.alarms],
+    }
+
+
+def _json_pair(pair: tuple[float, float] | None) -> list[float | None] | None:
+    return None if pair is None else [json_number(pair[0]), json_number(pair[1])]
+
+
+def _decision_json(verdict: Verdict | None) -> dict[str, Any] | None:
+    """The verdict as the decision rule gave it: ``rule`` names the rule (one-sided Bissell
+    bounds against the threshold), ``verdict`` its word, ``readings_needed`` the count that would
+    settle an INCONCLUSIVE one at the observed Cpk. ``capable`` beside it is the report's rule."""
+    if verdict is None:
+        return None
+    return {
+        "rule": verdict.rule,
+        "verdict": verdict.word,
+        "confidence": verdict.confidence,
+        "readings_needed": verdict.readings_needed,
     }
 
 

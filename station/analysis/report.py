@@ -24,7 +24,7 @@ from station.analysis.diagnostics import PERCENTILE_MIN_N, p_phrase
 from station.analysis.rules import number_list, rule_name
 from station.analysis.spatial import Spatial
 from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis
-from station.analysis.verdict import Verdict, judge_verdict
+from station.analysis.verdict import Verdict, confidence_text, judge_verdict
 
 if TYPE_CHECKING:
     from station.analysis.accuracy import AccuracyAnalysis
@@ -149,6 +149,10 @@ def format_histogram(
 WITHIN_SIGMA_SOURCE = {"I-MR": "MR-bar/d2", "Xbar-R": "R-bar/d2", "Xbar-S": "S-bar/c4"}
 
 
+def _interval(pair: tuple[float, float] | None) -> str:
+    return "-" if pair is None else f"{index(pair[0])} to {index(pair[1])}"
+
+
 def _capability_lines(
     cap: Capability,
     chart_type: str,
@@ -157,11 +161,15 @@ def _capability_lines(
     verdict: Verdict | None = None,
 ) -> list[str]:
     within_source = WITHIN_SIGMA_SOURCE.get(chart_type, "within subgroups")
+    level = confidence_text(cap.confidence)
     lines = [
-        f"CAPABILITY (overall sigma {unsigned(cap.sigma, decimals)}, report §2.7.3)",
+        f"CAPABILITY (overall sigma {unsigned(cap.sigma, decimals)}: report §2.7.3's Cp/Cpk, "
+        "ISO 22514-2's Pp/Ppk)",
         f"  Cp {index(cap.cp)}   Cpu {index(cap.cpu)}   Cpl {index(cap.cpl)}   "
         f"Cpk {index(cap.cpk) if verdict is None or verdict.cpk is None else verdict.cpk_text}",
-        f"  Cpk lower 95% confidence bound (Bissell): {index(cap.cpk_lower)}",
+        f"  Cp (Pp)   {level} interval {_interval(cap.cp_ci)} (chi-square)",
+        f"  Cpk (Ppk) {level} interval {_interval(cap.cpk_ci)}, one-sided bounds "
+        f"{index(cap.cpk_lower)} and {index(cap.cpk_upper)} (Bissell)",
         f"  Within sigma {unsigned(cap.sigma_within, decimals)} ({within_source}):",
         f"    Cp within {index(cap.cp_within)}   Cpk within {index(cap.cpk_within)}",
     ]

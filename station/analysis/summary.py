@@ -47,7 +47,7 @@ from station.analysis.phases import (
 )
 from station.analysis.rules import RULE_SETS, Alarm, check_rules
 from station.analysis.spatial import AXES, Spatial, find_axes, spatial_figures
-from station.analysis.verdict import DEFAULT_MIN_N, Verdict, judge_verdict
+from station.analysis.verdict import DEFAULT_MIN_N, NOT_CAPABLE, Verdict, judge_verdict
 from station.errors import StationError
 
 NO_LIMITS_MESSAGE = "no specification limits: give limits for this channel"
@@ -218,8 +218,13 @@ class Analysis:
 
     @property
     def incapable_channels(self) -> list[str]:
-        """Channels whose verdict is NOT CAPABLE (undefined verdicts are not listed)."""
-        return [name for name, c in self.channels.items() if c.capability.capable is False]
+        """Channels whose verdict is NOT CAPABLE (undefined, inconclusive and provisional
+        verdicts are not listed)."""
+        return [
+            name
+            for name, c in self.channels.items()
+            if c.verdict is not None and c.verdict.word == NOT_CAPABLE
+        ]
 
 
 def undefined_capability(

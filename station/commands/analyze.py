@@ -19,6 +19,7 @@ from station.commands._args import (
 )
 from station.errors import StationError
 from station.plain import plain
+from station.text import CAPABLE, INCONCLUSIVE, NOT_CAPABLE, judged_word
 
 if TYPE_CHECKING:
     from station.analysis.summary import AnalysisConfig
@@ -62,9 +63,12 @@ gains fit). A session file is analysed as its procedure declares (its
 
 exit codes:
   0  analysed
-  1  with --fail-if-incapable: a channel is not capable, has no verdict (no
-     limits) or only a provisional one (fewer readings than --min-n); a study
-     with a verdict of its own (gauge_linearity) is not ACCEPTABLE
+  1  with --fail-if-incapable: a channel is NOT CAPABLE (its confidence bound
+     is below the threshold), has no verdict (no limits) or only a provisional
+     one (fewer readings than --min-n); a study with a verdict of its own
+     (gauge_linearity) is not ACCEPTABLE. An INCONCLUSIVE channel (its bounds
+     straddle the threshold) passes, with a note on stderr; with
+     --fail-if-inconclusive it fails too
   2  bad input: missing or empty file, a cell that is not a number, impossible
      limits
 """
@@ -151,7 +155,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--fail-if-incapable",
         action="store_true",
-        help="exit 1 when any channel is not capable",
+        help="exit 1 when any channel is NOT CAPABLE, unjudged or provisional (an "
+        "INCONCLUSIVE one passes with a note)",
+    )
+    parser.add_argument(
+        "--fail-if-inconclusive",
+        action="store_true",
+        help="as --fail-if-incapable, and an INCONCLUSIVE channel fails too (exit 1 unless "
+        "every channel is CAPABLE)",
     )
     parser.set_defaults(func=run)
 
@@ -367,14 +378,26 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(report.document(), indent=indent, allow_nan=False))
     else:
         print(report.text())
-    if args.fail_if_incapable:
+    if args.fail_if_incapable or args.fail_if_inconclusive:
         # A channel without a verdict (no limits, too few readings) fails too: a script that
         # asks for the verdict must not pass on data that was never judged.
+        channels = analysis.channels.items() if analysis is not None else ()
         failed = [
             f"{name} ({_failure(c)})"
-            for name, c in (analysis.channels.items() if analysis is not None else ())
-            if c.capability.capable is not True or (c.verdict and c.verdict.provisional)
+            for name, c in channels
+            if _fails(c, strict=args.fail_if_inconclusive)
         ]
+        undecided = [
+            f"{name} ({_failure(c)})"
+            for name, c in channels
+            if not _fails(c, strict=args.fail_if_inconclusive) and judged_word(c) != CAPABLE
+        ]
+        if undecided:
+            print(
+                f"station: passed the capability check without proof: {', '.join(undecided)}; "
+                "--fail-if-inconclusive fails it",
+                file=sys.stderr,
+            )
         own = report.verdict
         if own is not None and own.accepted is not True:
             failed.append(f"{method.name} ({own.word})")
@@ -386,10 +409,22 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _fails(channel: Any, *, strict: bool) -> bool:
+    """Whether a channel fails ``--fail-if-incapable``: anything but CAPABLE, except that an
+    INCONCLUSIVE verdict (judged, neither proven) fails only when ``strict``."""
+    word = judged_word(channel)
+    return word != CAPABLE and (strict or word != INCONCLUSIVE)
+
+
 def _failure(channel: Any) -> str:
-    """Why a channel fails ``--fail-if-incapable``."""
-    if channel.capability.capable is False:
+    """Why a channel fails (or only passes) ``--fail-if-incapable``."""
+    verdict = channel.verdict
+    word = judged_word(channel)
+    if word == NOT_CAPABLE:
         return "not capable"
-    if channel.verdict is not None and channel.verdict.provisional:
-        return f"provisional: {channel.verdict.n} of {channel.verdict.min_n} readings"
+    if word == INCONCLUSIVE:
+        needed = verdict.readings_needed if verdict is not None else None
+        return "inconclusive" + (f": {needed} readings would settle it" if needed else "")
+    if verdict is not None and verdict.provisional:
+        return f"provisional: {verdict.n} of {verdict.min_n} readings"
     return "no verdict"

@@ -26,7 +26,7 @@ from station.record.content import parse_time
 from station.record.source import analyse_session
 from station.record.text import plain
 from station.session.store import list_sessions
-from station.text import UNDEFINED, overall_verdict, verdict_word
+from station.text import UNDEFINED, judged_word, overall_verdict
 
 SECONDS_PER_DAY = 86400.0
 
@@ -118,7 +118,7 @@ def _entry(path: Path, baseline_session: str | None) -> HistoryEntry:
             )
         if analysis.spatial is not None:
             rp = analysis.spatial.rp
-        verdict = overall_verdict(verdict_word(c.capability) for c in analysis.channels.values())
+        verdict = overall_verdict(judged_word(c) for c in analysis.channels.values())
     return HistoryEntry(
         path=path,
         created=session.created,

@@ -12,6 +12,8 @@ from station.analysis.capability import (
     capability,
     cp_interval,
     cpk_lower_bound,
+    cpk_upper_bound,
+    readings_needed,
 )
 from station.analysis.charts import sigma_within
 from station.errors import StationError
@@ -133,6 +135,41 @@ def test_cpk_lower_is_the_one_sided_bissell_bound(table_2_1):
     assert result.cpk_lower == pytest.approx(0.897, abs=5e-4)
     looser = capability(table_2_1, LIMITS, confidence=0.9)
     assert result.cpk_lower < looser.cpk_lower < result.cpk
+
+
+def test_table_2_1_carries_both_intervals_and_the_upper_bound(table_2_1):
+    result = capability(table_2_1, LIMITS)
+    assert result.cpk_upper == pytest.approx(cpk_upper_bound(result.cpk, 30), rel=1e-12)
+    assert result.cpk_lower + result.cpk_upper == pytest.approx(2 * result.cpk, rel=1e-12)
+    assert result.cpk_ci == pytest.approx(bissell_interval(result.cpk, 30, 0.95), rel=1e-12)
+    assert result.cp_ci == pytest.approx(cp_interval(result.cp, 30, 0.95), rel=1e-12)
+    # Two-sided at 95 % is wider than the one-sided 95 % bounds.
+    assert result.cpk_ci[0] < result.cpk_lower and result.cpk_upper < result.cpk_ci[1]
+    assert result.cpk_ci == pytest.approx((0.845, 1.491), abs=5e-4)
+    assert result.cp_ci == pytest.approx((0.941, 1.588), abs=5e-4)
+
+
+def test_an_upper_limit_only_has_no_cp_interval_but_a_cpk_interval(table_2_1):
+    result = capability(table_2_1, SpecLimits(usl=0.001))
+    assert result.cp_ci is None and result.cpk_ci is not None and result.cpk_upper is not None
+
+
+def test_undefined_indices_have_no_bounds():
+    result = capability([0.0001] * 30, LIMITS)
+    assert (result.cpk_upper, result.cp_ci, result.cpk_ci) == (None, None, None)
+
+
+def test_readings_needed_is_the_fewest_that_settle_the_bound(table_2_1):
+    cpk = capability(table_2_1, LIMITS).cpk
+    # The issue's figure: Table 2-1's bound reaches 1 at 77 readings, not at 76.
+    assert readings_needed(cpk, 1.0) == 77
+    assert cpk_lower_bound(cpk, 76) < 1.0 <= cpk_lower_bound(cpk, 77)
+    # Below the threshold: the upper bound must fall below it.
+    needed = readings_needed(0.9, 1.0)
+    assert cpk_upper_bound(0.9, needed - 1) >= 1.0 > cpk_upper_bound(0.9, needed)
+    assert readings_needed(1.0, 1.0) is None
+    assert readings_needed(1.0 + 1e-9, 1.0) is None  # more than anyone will take
+    assert readings_needed(1.5, 1.0, 0.99) > readings_needed(1.5, 1.0, 0.95)
 
 
 def test_bissell_bound_moves_the_right_way_for_a_negative_cpk():

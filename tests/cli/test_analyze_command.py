@@ -51,7 +51,11 @@ def test_text_report_of_table_2_1_shows_the_reports_figures():
         "MODE: +0.00020",
         "SKEWNESS a1: -0.356",
         "Cp 1.26   Cpu 1.17   Cpl 1.36   Cpk 1.17",
-        "VERDICT: CAPABLE",
+        "Cp (Pp)   95% interval 0.94 to 1.59 (chi-square)",
+        "Cpk (Ppk) 95% interval 0.84 to 1.49, one-sided bounds 0.90 and 1.44 (Bissell)",
+        # Issue 20: 30 readings cannot show a Cpk of 1.17 above 1; the report's rule beside it.
+        "VERDICT: INCONCLUSIVE (Cpk 1.17; Bissell 95% bounds 0.90 to 1.44 straddle 1: 77",
+        "by the report's rule: capable, Cpk 1.17",
     ]:
         assert figure in result.stdout, figure
     assert max(len(line) for line in result.stdout.splitlines()) <= 80
@@ -73,6 +77,10 @@ def test_json_has_every_documented_key(xyz_csv):
             "cpl",
             "cpk",
             "cpk_lower",
+            "cpk_upper",
+            "cp_ci",
+            "cpk_ci",
+            "decision",
             "cp_within",
             "cpk_within",
             "threshold",
@@ -102,16 +110,45 @@ def test_fail_if_incapable_exits_1_and_names_the_channel(xyz_csv):
     result = station(xyz_csv, *REPORT_LIMITS, "--fail-if-incapable", "--json")
     assert result.returncode == 1
     assert json.loads(result.stdout)["channels"]["z"]["capability"]["capable"] is False
-    assert result.stderr.strip() == "station: failed the capability check: z (not capable)"
+    # y's bounds straddle 1: it passes, and stderr says it passed without proof.
+    assert result.stderr.strip().splitlines() == [
+        "station: passed the capability check without proof: y (inconclusive: 57 readings "
+        "would settle it); --fail-if-inconclusive fails it",
+        "station: failed the capability check: z (not capable)",
+    ]
 
 
 def test_fail_if_incapable_passes_capable_data():
-    result = station(TABLE_2_1, *REPORT_LIMITS, "--fail-if-incapable", "--capable-at", "1.1")
+    result = station(TABLE_2_1, *REPORT_LIMITS, "--fail-if-incapable", "--capable-at", "0.85")
     assert result.returncode == 0, result.stderr
+    assert result.stderr == ""
+
+
+def test_an_inconclusive_channel_passes_fail_if_incapable_and_fails_fail_if_inconclusive():
+    result = station(TABLE_2_1, *REPORT_LIMITS, "--json", "--fail-if-incapable")
+    assert result.returncode == 0
+    capability = json.loads(result.stdout)["channels"]["x"]["capability"]
+    assert capability["capable"] is True  # the report's own rule, unchanged
+    assert capability["decision"] == {
+        "rule": "bissell-one-sided-bounds",
+        "verdict": "INCONCLUSIVE",
+        "confidence": 0.95,
+        "readings_needed": 77,
+    }
+    assert capability["cpk_upper"] == pytest.approx(1.4394, abs=1e-4)
+    assert capability["cpk_ci"] == pytest.approx([0.8446, 1.4914], abs=1e-4)
+    assert capability["cp_ci"] == pytest.approx([0.9410, 1.5884], abs=1e-4)
+    assert "x (inconclusive: 77 readings would settle it)" in result.stderr
+    strict = station(TABLE_2_1, *REPORT_LIMITS, "--fail-if-inconclusive")
+    assert strict.returncode == 1
+    assert strict.stderr.strip() == (
+        "station: failed the capability check: x (inconclusive: 77 readings would settle it)"
+    )
 
 
 def test_a_higher_capability_threshold_fails_table_2_1():
-    result = station(TABLE_2_1, *REPORT_LIMITS, "--fail-if-incapable", "--capable-at", "1.33")
+    # Above the upper bound 1.44: NOT CAPABLE.
+    result = station(TABLE_2_1, *REPORT_LIMITS, "--fail-if-incapable", "--capable-at", "1.5")
     assert result.returncode == 1
     assert "x (not capable)" in result.stderr
 

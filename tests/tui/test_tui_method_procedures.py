@@ -157,7 +157,7 @@ async def test_gauge_check_through_the_tui(tmp_path: Path, simulator: str, tui) 
         assert f"gauge register: MIT-0042, passed on {dt.date.today().isoformat()}" in report
         assert "25 readings" in text_of(app, "#summary-title")
         verdict = text_of(app, "#summary-verdict")
-        assert "Verdict: CAPABLE" in verdict and "Cpk ≥ 1.33" in verdict
+        assert "Verdict: CAPABLE" in verdict and "lower bound ≥ 1.33" in verdict
         view = app.screen.view
     document = analyze_json(view.path)
     study = document["gauge_check"]

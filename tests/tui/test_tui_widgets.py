@@ -20,11 +20,11 @@ from station.errors import StationError
 from station.text import (
     figure_decimals,
     format_figure,
+    judged_word,
     limits_text,
     overall_verdict,
     parse_channel_map,
     parse_limits_text,
-    verdict_word,
 )
 from station.tui.widgets.alarm_log import alarm_lines
 from station.tui.widgets.control_chart import chart_data, render_chart
@@ -125,9 +125,14 @@ def test_stats_table_writes_verdict_words_within_80_columns() -> None:
     console.print(stats_table(rows))
     text = console.export_text()
     assert all(cell_len(line) <= 78 for line in text.splitlines())
-    words = {verdict_word(c.capability) for c in analysis.channels.values()}
+    words = {judged_word(c) for c in analysis.channels.values()}
     for word in words:
         assert word in text
+    # The bounds the words rest on (issue 20), one pair per channel.
+    caption = next(line for line in text.splitlines() if "bounds (Bissell)" in line)
+    x = analysis.channels["x"].capability
+    assert caption.startswith("Cpk 95% bounds (Bissell): x ")
+    assert f"x {x.cpk_lower:.2f}-{x.cpk_upper:.2f}" in caption
     assert "▶y" in text
     assert "+0.00010" in text  # the live reading of x
 
@@ -193,6 +198,8 @@ def test_figures() -> None:
     assert overall_verdict(["CAPABLE", "NOT CAPABLE"]) == "NOT CAPABLE"
     assert overall_verdict(["CAPABLE", "CAPABLE"]) == "CAPABLE"
     assert overall_verdict(["CAPABLE", "UNDEFINED"]) == "UNDEFINED"
+    assert overall_verdict(["CAPABLE", "INCONCLUSIVE"]) == "INCONCLUSIVE"
+    assert overall_verdict(["INCONCLUSIVE", "NOT CAPABLE"]) == "NOT CAPABLE"
 
 
 def test_stats_table_flags_out_of_spec_and_says_provisional() -> None:

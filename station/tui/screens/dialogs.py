@@ -117,9 +117,11 @@ HELP_TEXT = """\
 
 Every reading is on disk (fsynced) before it is shown as captured.
 If the link drops, the session is marked interrupted; run `station`
-again and choose Resume. Verdicts: CAPABLE when Cpk ≥ the threshold
-(1.00 by default), NOT CAPABLE otherwise, UNDEFINED when there are no
-limits or too few readings.
+again and choose Resume. Verdicts: CAPABLE when Cpk's 95% lower
+bound (Bissell) reaches the threshold (1.00 by default), NOT CAPABLE
+when its upper bound is below it, INCONCLUSIVE between (with the
+readings that would settle it; the report's rule Cpk ≥ 1 is shown
+beside it), UNDEFINED when there are no limits or too few readings.
 PROVISIONAL: 9 of 25 while fewer readings than the procedure's
 minimum are in. The Cpk is shown with as many decimals as it takes
 to sit on the same side of the threshold. Alarms: report rule 1 = a

@@ -26,11 +26,15 @@ from textual.screen import Screen
 from textual.widgets import Footer, Static
 
 from station.analysis.rules import rule_name
+from station.analysis.verdict import confidence_text
 from station.errors import StationError
 from station.session.durable import write_text_durably
 from station.session.export import export_csv
 from station.session.model import load_session
 from station.text import (
+    CAPABLE,
+    INCONCLUSIVE,
+    NOT_CAPABLE,
     format_figure,
     format_index,
     judged_cpk,
@@ -193,26 +197,40 @@ def verdict_text(view: SummaryView) -> Text:
     text.append("Verdict: ", style="bold")
     text.append(overall, style=VERDICT_STYLES.get(overall.partition(":")[0], ""))
     threshold = analysis.config.threshold
+    level = confidence_text(analysis.config.confidence)
     text.append(
-        f"   (Cpk ≥ {threshold:g} is capable; final from {analysis.config.min_n} readings; "
-        f"unit {view.unit})\n",
+        f"   (capable when Cpk's {level} lower bound ≥ {threshold:g}; (lower–upper) its "
+        f"one-sided {level} bounds, Bissell; final from "
+        f"{analysis.config.min_n} readings; unit {view.unit})\n",
         style="dim",
     )
     for name, channel in analysis.channels.items():
         word = judged_word(channel)
         capability = channel.capability
         descriptive = channel.descriptive
-        bound = capability.cpk_lower
-        lower = f"≥{format_index(bound)}" if bound is not None else format_index(None)
+        bounds = (
+            f"{format_index(capability.cpk_lower)}–{format_index(capability.cpk_upper)}"
+            if capability.cpk_lower is not None and capability.cpk_upper is not None
+            else format_index(None)
+        )
         text.append(f"  {shown_line(name, limit=20)}  ", style="bold")
         # The word alone: the verdict line above says how many of how many (the axes share
         # it), so the axis' figures fit one line at 80 columns ("σ" was left alone at its end).
-        text.append(f"{word:<11}", style=VERDICT_STYLES.get(word, ""))
+        text.append(f"{word:<12}", style=VERDICT_STYLES.get(word, ""))
         text.append(
-            f" Cp {format_index(capability.cp)}  Cpk {judged_cpk(channel)} (95%: {lower})  X̄ "
-            f"{format_figure(descriptive.mean, view.resolution)}"
+            f" Cp {format_index(capability.cp)}  Cpk {judged_cpk(channel)} ({bounds})"
+            f"  X̄ {format_figure(descriptive.mean, view.resolution)}"
             f"  σ {format_figure(descriptive.sd, view.resolution, signed=False)}\n"
         )
+        verdict = channel.verdict
+        if verdict is not None and word in (INCONCLUSIVE, CAPABLE, NOT_CAPABLE):
+            # Why the word, and the report's own rule beside it (issue 20).
+            settle = (
+                f"{verdict.readings_needed} readings settle it; "
+                if verdict.readings_needed is not None
+                else ""
+            )
+            text.append(f"    {settle}{verdict.rule_text}\n", style="dim")
         if word == "UNDEFINED" and capability.message:
             text.append(f"      {shown_line(capability.message, limit=None)}\n", style="yellow")
         one_sided = one_sided_sentence(capability, view.resolution, view.unit)

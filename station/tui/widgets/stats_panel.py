@@ -5,7 +5,9 @@ One row per channel, so x, y and z sit one above the other and the table fits 80
 selected channel (the one the charts below show) is marked with ``▶``. A last reading beyond a
 specification limit is marked ``▲`` (above the USL) or ``▼`` (below the LSL) at once, and the
 ``out`` column counts each channel's readings out of specification. Below the minimum count
-the verdict is PROVISIONAL, and a caption says how many readings are in of how many needed.
+the verdict is PROVISIONAL, and a caption says how many readings are in of how many needed;
+another gives each channel's confidence bounds on Cpk, which decide CAPABLE, NOT CAPABLE or
+INCONCLUSIVE.
 Values come from the analysis the runner keeps; nothing is computed here.
 """
 
@@ -20,6 +22,7 @@ from rich.table import Table
 from rich.text import Text
 from textual.widgets import Static
 
+from station.analysis.verdict import confidence_text
 from station.text import (
     NOT_AVAILABLE,
     format_figure,
@@ -73,7 +76,7 @@ def stats_table(rows: StatsRows) -> Table:
     }
     for heading, width in widths.items():
         table.add_column(heading, justify="right", no_wrap=True, min_width=width)
-    table.add_column("verdict", no_wrap=True, min_width=11)
+    table.add_column("verdict", no_wrap=True, min_width=len("INCONCLUSIVE"))
     provisional = []
     for channel in rows.channels:
         analysis = rows.analyses.get(channel)
@@ -104,14 +107,36 @@ def stats_table(rows: StatsRows) -> Table:
             Text(str(out), style="bold red" if out else "dim"),
             Text(word, style=VERDICT_STYLES.get(word, "")),
         )
+    captions = []
     if provisional:
         fewest = min(provisional, key=lambda verdict: verdict.n)
-        table.caption = (
+        captions.append(
             f"PROVISIONAL: {fewest.n} of {fewest.min_n} readings, "
             f"{fewest.min_n - fewest.n} more before a verdict"
         )
+    bounds = bounds_caption(rows)
+    if bounds:
+        captions.append(bounds)
+    if captions:
+        table.caption = "\n".join(captions)
         table.caption_justify = "left"
     return table
+
+
+def bounds_caption(rows: StatsRows) -> str:
+    """The one-sided confidence bounds on each channel's Cpk the verdict weighs (issue 20):
+    ``Cpk 95% bounds (Bissell): x 0.90-1.44  y 1.02-1.61``; empty while none has a Cpk."""
+    level = ""
+    shown = []
+    for channel in rows.channels:
+        capability = getattr(rows.analyses.get(channel), "capability", None)
+        lower = getattr(capability, "cpk_lower", None)
+        upper = getattr(capability, "cpk_upper", None)
+        if lower is None or upper is None:
+            continue
+        level = confidence_text(capability.confidence)
+        shown.append(f"{shown_line(channel, limit=8)} {format_index(lower)}-{format_index(upper)}")
+    return f"Cpk {level} bounds (Bissell): " + "  ".join(shown) if shown else ""
 
 
 class StatsPanel(Static):
