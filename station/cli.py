@@ -16,6 +16,7 @@ TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
 if TYPE_CHECKING:
     import argparse
     from collections.abc import Sequence
+    from typing import TextIO
 
 
 def command_names() -> list[str]:
@@ -165,14 +166,14 @@ def _run(parser: argparse.ArgumentParser, arguments: list[str]) -> int:
         raise
 
 
-def _output_failed(stderr: object, error: OSError) -> int:
+def _output_failed(stderr: TextIO, error: OSError) -> int:
     import contextlib
 
     with contextlib.suppress(OSError, ValueError):
         print(
             f"station: cannot write the output ({error.strerror}); free some space or "
             "write it elsewhere",
-            file=stderr,  # type: ignore[arg-type]
+            file=stderr,
             flush=True,
         )
     return 1

@@ -82,7 +82,7 @@ class PlainStream(io.TextIOBase):
         super().__init__()
         self._stream = stream
 
-    def write(self, text: str) -> int:  # type: ignore[override]
+    def write(self, text: str) -> int:
         """Write ``text`` with its control characters made visible; returns ``len(text)``."""
         self._stream.write(plain(text, one_line=False))
         return len(text)

@@ -230,8 +230,8 @@ def parse_limits_text(text: str) -> TypedLimits | None:
         raise StationError(f"{text!r} is not a limit: write {LIMIT_HELP}", field="limits")
     lsl = float(both.group(1)) if both.group(1) is not None else None
     usl = float(both.group(2)) if both.group(2) is not None else None
-    for value in (lsl, usl):
-        if value is not None and not math.isfinite(value):
+    for limit in (lsl, usl):
+        if limit is not None and not math.isfinite(limit):
             raise StationError(f"{text!r}: a limit must be a finite number", field="limits")
     if lsl is not None and usl is not None and usl <= lsl:
         raise StationError(

@@ -82,7 +82,8 @@ def _pendant(value: Any) -> tuple[float, float, float]:
         raise StationError(
             f"pendant coordinates must be three finite numbers X, Y, Z, not {value}."
         )
-    return coordinates  # type: ignore[return-value]
+    x, y, z = coordinates
+    return x, y, z
 
 
 def analyze_accuracy(
@@ -113,7 +114,7 @@ def analyze_accuracy(
             )
     if np.any(numbers != np.round(numbers)):
         raise StationError("the placement column must hold whole numbers (1, 2, 3, ...).")
-    pendant = {int(k): _pendant(v) for k, v in (pendant or {}).items()}
+    pendant_at = {int(k): _pendant(v) for k, v in (pendant or {}).items()}
 
     overall = analyze(arrays, config, excluded_cycles=excluded_cycles)
     total = np.sqrt(sum(values**2 for values in arrays.values()))
@@ -125,7 +126,7 @@ def analyze_accuracy(
     for number in dict.fromkeys(numbers.astype(int).tolist()):
         rows = numbers == number
         chosen = {axis: values[rows] for axis, values in arrays.items()}
-        coordinates = pendant.get(number)
+        coordinates = pendant_at.get(number)
         results.append(
             PlacementResult(
                 number=number,
@@ -141,7 +142,7 @@ def analyze_accuracy(
             )
         )
     means = {axis: np.asarray([r.mean[axis] for r in results]) for axis in AXES}
-    per_unit = None
+    per_unit: tuple[tuple[float, float, float], ...] | None = None
     located = [r for r in results if r.pendant is not None]
     if len(located) >= 3:
         moves = np.asarray([r.pendant for r in located])
@@ -149,7 +150,7 @@ def analyze_accuracy(
         if np.linalg.matrix_rank(moves) == 3:
             # observed ≈ moves @ M.T: one least-squares problem per error axis.
             solution, *_ = np.linalg.lstsq(moves, observed, rcond=None)
-            per_unit = tuple(tuple(float(v) for v in row) for row in solution.T)
+            per_unit = tuple((float(a), float(b), float(c)) for a, b, c in solution.T)
     return AccuracyAnalysis(
         overall=overall,
         error_3d=error_3d,

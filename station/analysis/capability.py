@@ -259,14 +259,16 @@ def capability(
     above = int(np.count_nonzero(array > usl)) if usl is not None else 0
     below = int(np.count_nonzero(array < lsl)) if lsl is not None else 0
     reasons: list[str] = []
-    mean = sigma = within = None
+    mean: float | None = None
+    sigma: float | None = None
+    within: float | None = None
     if n < 2:
         reasons.append(f"need at least 2 readings to estimate sigma (have {n})")
         if n == 1:
             mean = float(array[0])
     else:
         mean, sigma = mean_and_sd(array)
-        if sigma == 0:
+        if sigma == 0 and mean is not None:
             reasons.append(
                 # Positional, as every other figure on the screens ("-4e-05" read as a code).
                 f"sigma is 0: every reading is the same ({format(Decimal(repr(float(mean))), 'f')})"

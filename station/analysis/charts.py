@@ -16,10 +16,12 @@ except that qcc takes d2 from a 3-decimal table (d2(2) = 1.128) where we use the
 
 from __future__ import annotations
 
+import contextlib
 import math
 import operator
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import SupportsIndex
 
 import numpy as np
 
@@ -86,15 +88,15 @@ def chart_type(subgroup: int, kind: str | None = None) -> str:
     return kind
 
 
-def check_subgroup(subgroup: int) -> int:
+def check_subgroup(subgroup: SupportsIndex | float) -> int:
     """The subgroup size as an int; StationError unless it is a whole number >= 1."""
     size = None
-    if not isinstance(subgroup, bool):
-        try:
+    if isinstance(subgroup, float):
+        if subgroup.is_integer():
+            size = int(subgroup)
+    elif not isinstance(subgroup, bool):
+        with contextlib.suppress(TypeError):
             size = operator.index(subgroup)
-        except TypeError:
-            if isinstance(subgroup, float) and subgroup.is_integer():
-                size = int(subgroup)
     if size is None or size < 1:
         raise StationError(
             f"subgroup size {subgroup!r} is not a whole number of at least 1: use 1 for single "

@@ -179,17 +179,17 @@ def _choose(scores: Sequence[OrderScore], criterion: Criterion, scale: float) ->
     minimum alone over-fits now and then). AICc: the smallest, ties within 1e-9.
     """
     if criterion == "loo":
-        usable = [s for s in scores if s.loo_rmse is not None]
-        if not usable:
+        rated = [(s, s.loo_rmse) for s in scores if s.loo_rmse is not None]
+        if not rated:
             raise StationError("no order leaves a position out: give more tuned positions.")
-        best = min(usable, key=lambda s: s.loo_rmse)  # type: ignore[arg-type, return-value]
-        allowed = best.loo_rmse**2 + (best.loo_se or 0.0) + (_NOISE_FLOOR * scale) ** 2  # type: ignore[operator]
-        return next(s for s in usable if s.loo_rmse**2 <= allowed)  # type: ignore[operator]
-    usable = [s for s in scores if s.aicc is not None]
-    if not usable:
+        best, best_rmse = min(rated, key=lambda pair: pair[1])
+        allowed = best_rmse**2 + (best.loo_se or 0.0) + (_NOISE_FLOOR * scale) ** 2
+        return next(s for s, rmse in rated if rmse**2 <= allowed)
+    ranked = [(s, s.aicc) for s in scores if s.aicc is not None]
+    if not ranked:
         raise StationError("AICc needs 3 or more tuned positions to choose an order: give --order.")
-    best = min(s.aicc for s in usable)  # type: ignore[type-var]
-    return next(s for s in usable if s.aicc <= best + 1e-9)  # type: ignore[operator]
+    best_aicc = min(aicc for _, aicc in ranked)
+    return next(s for s, aicc in ranked if aicc <= best_aicc + 1e-9)
 
 
 def _overshoot(series: Any, q: Any) -> float:

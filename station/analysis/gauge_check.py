@@ -222,15 +222,20 @@ def gauge_check(
     # Readings that differ by float rounding only (0.1 read as 0.30000000000000004 − 0.2 after
     # a software zero) are the same value: their s of 1e-17 would give a Cg of 1e13.
     same = float(np.ptp(readings)) <= 1e-9 * max(1.0, float(np.max(np.abs(readings))))
+    cg: float | None
+    cgk: float | None
+    bias_t: float | None
+    bias_p: float | None
+    capable: bool | None
     if sd > 0 and not same:
         k = PERCENT_OF_TOLERANCE / 100.0
-        cg: float | None = (k * tolerance) / (SPREAD_SIGMAS * sd)
-        cgk: float | None = (k / 2.0 * tolerance - abs(bias)) / (SPREAD_SIGMAS / 2.0 * sd)
+        cg = (k * tolerance) / (SPREAD_SIGMAS * sd)
+        cgk = (k / 2.0 * tolerance - abs(bias)) / (SPREAD_SIGMAS / 2.0 * sd)
         # The one-sample t-test of scipy.stats.ttest_1samp, written out: scipy warns of
         # "catastrophic cancellation" on readings that are nearly all one display value.
-        bias_t: float | None = bias / (sd / math.sqrt(n))
-        bias_p: float | None = float(2.0 * stats.t.sf(abs(bias_t), n - 1))
-        capable: bool | None = cg >= CAPABLE_AT and cgk >= CAPABLE_AT
+        bias_t = bias / (sd / math.sqrt(n))
+        bias_p = float(2.0 * stats.t.sf(abs(bias_t), n - 1))
+        capable = cg >= CAPABLE_AT and cgk >= CAPABLE_AT
     else:
         cg = cgk = bias_t = bias_p = None
         capable = None

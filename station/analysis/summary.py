@@ -270,7 +270,7 @@ class PointCycles(Sequence[tuple[int, ...]]):
     def __len__(self) -> int:
         return self._points
 
-    def __getitem__(self, index):  # type: ignore[override]
+    def __getitem__(self, index):
         if isinstance(index, slice):
             return [self[i] for i in range(*index.indices(self._points))]
         if index < 0:
@@ -428,11 +428,15 @@ def spatial_of(channels: Mapping[str, np.ndarray], config: AnalysisConfig) -> Sp
     axes = find_axes(list(channels))
     if axes is None:
         return None
-    arrays = [np.asarray(channels[axes[axis]], dtype=float) for axis in AXES]
-    if len({len(a) for a in arrays}) != 1 or len(arrays[0]) == 0:
+    x, y, z = (np.asarray(channels[axes[axis]], dtype=float) for axis in AXES)
+    if not len(x) == len(y) == len(z) or len(x) == 0:
         return None
-    nominal = tuple(config.nominal_for(axes[axis]) for axis in AXES)
-    return spatial_figures(*arrays, nominal=nominal)  # type: ignore[arg-type]
+    nominal = (
+        config.nominal_for(axes["x"]),
+        config.nominal_for(axes["y"]),
+        config.nominal_for(axes["z"]),
+    )
+    return spatial_figures(x, y, z, nominal=nominal)
 
 
 def hints_of(channels: Sequence[ChannelAnalysis], config: AnalysisConfig) -> tuple[str, ...]:
@@ -471,11 +475,13 @@ def diagnostic_hints(channel: ChannelAnalysis) -> list[str]:
     auto = channel.autocorrelation
     if auto is not None and auto.significant and auto.message:
         hints.append(f"{channel.name}: {auto.message}.")
-    if channel.percentile is not None and channel.normality is not None:
+    normality = channel.normality
+    # A percentile index exists only when the test rejected normality, on a p-value.
+    if channel.percentile is not None and normality is not None and normality.p_value is not None:
         ppk = channel.percentile.ppk
         hints.append(
-            f"{channel.name}: the readings are not normal ({channel.normality.test}, "
-            f"{p_phrase(channel.normality.p_value)}): judge by the percentile index "
+            f"{channel.name}: the readings are not normal ({normality.test}, "
+            f"{p_phrase(normality.p_value)}): judge by the percentile index "
             f"Ppk (percentile) {'undefined' if ppk is None else f'{ppk:.2f}'} as well as Cpk."
         )
     return hints

@@ -24,11 +24,13 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, ClassVar, Literal, Protocol, TextIO
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, Protocol
 
 from station.procedures import AnalysisNeeds, Procedure, step_schema
 
 if TYPE_CHECKING:
+    from _typeshed import SupportsWrite
+
     from station.analysis.summary import Analysis, AnalysisConfig
     from station.instruments.simulator import GaugeSpec
     from station.session.model import Session
@@ -202,10 +204,14 @@ class ChartKit(Protocol):
     """What a method draws its charts with (the record's figure, colours and labels, so that
     every chart of a report looks alike); given by :mod:`station.record.charts`."""
 
-    point: str
-    centre: str
-    limit: str
-    alarm: str
+    @property
+    def point(self) -> str: ...
+    @property
+    def centre(self) -> str: ...
+    @property
+    def limit(self) -> str: ...
+    @property
+    def alarm(self) -> str: ...
 
     def figure(self, width: float = 7.0, height: float = 3.2) -> Any:
         """A new matplotlib ``Figure`` of that size (inches)."""
@@ -342,7 +348,7 @@ class Method(ABC):
         report draws of the judged channels."""
         return ()
 
-    def write_wide(self, session: Session, out: TextIO) -> int:
+    def write_wide(self, session: Session, out: SupportsWrite[str]) -> int:
         """Write ``session`` as the CSV table this method's analysis reads (``station export
         --layout wide``); the data rows. By default ``cycle``, ``t`` and one column per
         channel of the accepted cycles."""

@@ -8,10 +8,13 @@ layout, a row per reading, is :func:`station.session.export.export_csv`.
 
 from __future__ import annotations
 
-from typing import TextIO
+from typing import TYPE_CHECKING
 
 from station.session.export import one_line
 from station.session.model import Session
+
+if TYPE_CHECKING:
+    from _typeshed import SupportsWrite
 
 
 def number(value: float) -> str:
@@ -19,7 +22,7 @@ def number(value: float) -> str:
     return repr(float(value))
 
 
-def export_comments(session: Session, out: TextIO) -> None:
+def export_comments(session: Session, out: SupportsWrite[str]) -> None:
     """``#`` lines naming the session and its rejected cycles (readers skip them; ``station
     analyze`` lists those cycles as excluded)."""
     name, procedure, unit = (

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, overload
 
 from station.errors import StationError
 from station.procedures.model import ID_PATTERN
@@ -62,8 +62,41 @@ class Checker:
             raise self.fail(where, f"{key!r} must not be empty")
         return value
 
-    def number(self, table: Mapping[str, Any], key: str, where: str, **kw: Any) -> float:
-        value = self.get(table, key, (int, float), where, **kw)
+    @overload
+    def number(
+        self,
+        table: Mapping[str, Any],
+        key: str,
+        where: str,
+        *,
+        required: Literal[True] = True,
+        default: float | None = None,
+    ) -> float: ...
+    @overload
+    def number(
+        self, table: Mapping[str, Any], key: str, where: str, *, required: bool, default: float
+    ) -> float: ...
+    @overload
+    def number(
+        self,
+        table: Mapping[str, Any],
+        key: str,
+        where: str,
+        *,
+        required: bool,
+        default: None = None,
+    ) -> float | None: ...
+    def number(
+        self,
+        table: Mapping[str, Any],
+        key: str,
+        where: str,
+        *,
+        required: bool = True,
+        default: float | None = None,
+    ) -> float | None:
+        """The number at ``key``, finite; ``default`` when it is absent and not ``required``."""
+        value = self.get(table, key, (int, float), where, required=required, default=default)
         if value is None:
             return value
         try:

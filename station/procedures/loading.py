@@ -246,8 +246,8 @@ def _analysis_kind(
                 return name
         return known[0]
     if declared not in analysis_kinds():
-        known = ", ".join(analysis_kinds())
-        raise check.fail("", f"'analysis' must be one of {known}, not {declared!r}")
+        listed = ", ".join(analysis_kinds())
+        raise check.fail("", f"'analysis' must be one of {listed}, not {declared!r}")
     needs = analysis_needs(declared)
     if needs.facet:
         # A facet inside a block: the steps of the blocks (a cycles step per joint).
@@ -398,10 +398,10 @@ def _parse_step(context: _StepContext, raw: Any, number: str, *, nested: bool = 
         # always: one reading is no zero); ``settle`` and ``still`` keep their defaults.
         values["readings"] = readings
         for key, default in (("settle", DEFAULT_ZERO_SETTLE), ("still", DEFAULT_ZERO_STILL)):
-            number = check.number(raw, key, where, required=False)
-            if number is not None and not number > 0:
-                raise check.fail(where, f"{key!r} must be greater than 0, not {number}")
-            values[key] = default if number is None else number
+            seconds = check.number(raw, key, where, required=False)
+            if seconds is not None and not seconds > 0:
+                raise check.fail(where, f"{key!r} must be greater than 0, not {seconds}")
+            values[key] = default if seconds is None else seconds
     if schema.direction:
         direction = check.text(raw, "direction_channel", where)
         if direction not in values["channels"]:

@@ -20,7 +20,7 @@ import re
 import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -29,7 +29,11 @@ from station.plain import plain
 from station.record.content import parse_time
 from station.record.source import AnalysedSession
 
-RC = {
+if TYPE_CHECKING:
+    # The type only: this module loads matplotlib when it draws.
+    from matplotlib.typing import RcKeyType
+
+RC: dict[RcKeyType, Any] = {
     "svg.fonttype": "none",
     "text.parse_math": False,
     "text.usetex": False,

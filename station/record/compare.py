@@ -25,9 +25,10 @@ from typing import Any
 
 import numpy as np
 
+from station.analysis.summary import Analysis
 from station.errors import StationError
 from station.record.content import decimals_for
-from station.record.source import analyse_session
+from station.record.source import AnalysedSession, analyse_session
 
 
 @dataclass(frozen=True)
@@ -266,6 +267,13 @@ def compare_channels(
     )
 
 
+def _analysis_of(analysed: AnalysedSession) -> Analysis:
+    """The session's analysis; StationError saying why there is none."""
+    if analysed.report is None or analysed.report.analysis is None:
+        raise StationError(f"{analysed.path.name}: {analysed.problem}; nothing to compare.")
+    return analysed.report.analysis
+
+
 def compare_sessions(
     path_a: str | Path, path_b: str | Path, *, confidence: float = 0.95
 ) -> Comparison:
@@ -284,10 +292,7 @@ def compare_sessions(
             f"{sa.path.name} is in {sa.unit} and {sb.path.name} in {sb.unit}: only sessions in "
             "one unit can be compared."
         )
-    for analysed in (first, second):
-        if analysed.report is None or analysed.report.analysis is None:
-            raise StationError(f"{analysed.path.name}: {analysed.problem}; nothing to compare.")
-    analysis_a, analysis_b = first.report.analysis, second.report.analysis  # type: ignore[union-attr]
+    analysis_a, analysis_b = _analysis_of(first), _analysis_of(second)
     readings_a = {name: c.readings for name, c in analysis_a.channels.items()}
     readings_b = {name: c.readings for name, c in analysis_b.channels.items()}
     if not set(readings_a) & set(readings_b):

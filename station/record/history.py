@@ -107,9 +107,14 @@ def _entry(path: Path, baseline_session: str | None) -> HistoryEntry:
         analysis = analysed.report.analysis
         for name, channel in analysis.channels.items():
             cap = channel.capability
+            mean = channel.descriptive.mean
+            if mean is None:
+                # No reading, no figures (an analysed channel has readings: this does not
+                # happen, and a history line without the channel is what it would mean).
+                continue
             channels[name] = ChannelFigures(
-                mean=channel.descriptive.mean,
-                offset=channel.descriptive.mean - channel.nominal,
+                mean=mean,
+                offset=mean - channel.nominal,
                 sd=channel.descriptive.sd,
                 cpk=cap.cpk,
                 capable=cap.capable,

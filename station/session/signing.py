@@ -28,7 +28,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, overload
 
 from cryptography.exceptions import InvalidSignature
 from cryptography.hazmat.primitives import serialization
@@ -110,6 +110,10 @@ def finish_message(session_id: str, prev: str, seq: int) -> bytes:
     )
 
 
+@overload
+def station_key(create: Literal[True] = True) -> StationKey: ...
+@overload
+def station_key(create: bool) -> StationKey | None: ...
 def station_key(create: bool = True) -> StationKey | None:
     """The station's key, made on first use when ``create`` (None when it does not exist and
     ``create`` is False). StationError when the key file cannot be read or made."""
@@ -192,9 +196,9 @@ def _make_key(path: Path) -> StationKey:
         key = StationKey(private, _raw_public(private))
     except FileExistsError:
         # Another session made it first: use that one.
-        key = station_key(create=False)
-        assert key is not None
-        return key
+        theirs = station_key(create=False)
+        assert theirs is not None
+        return theirs
     except OSError as error:
         raise StationError(
             f"cannot write the station's signing key {path}: {error.strerror}"

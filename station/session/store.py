@@ -9,6 +9,7 @@ import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypedDict
 
 from station.errors import StationError
 from station.session.durable import data_home, refuse_links_below
@@ -119,7 +120,15 @@ def summarise(path: Path) -> SessionSummary:
     )
 
 
-def _progress(session: Session) -> dict[str, object]:
+class _Progress(TypedDict):
+    """The progress fields of a :class:`SessionSummary`."""
+
+    counted: str
+    done: int
+    target: int | None
+
+
+def _progress(session: Session) -> _Progress:
     """What ``session`` counts, how many are in and how many were asked for: points toward
     strokes for a stroke step (a linearity session streams points, not cycles), placements for a
     repeated block, else accepted cycles."""

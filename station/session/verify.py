@@ -20,6 +20,7 @@ from pathlib import Path
 from station.plain import plain
 from station.session.lines import SessionFileError, decode_line, line_hash
 from station.session.model import read_session_bytes, replay_bytes
+from station.session.replay import Replay
 from station.session.signing import check_finish_signature, key_id, predates_signing
 from station.session.trust import find_trusted
 
@@ -101,19 +102,21 @@ def _verify_chain(path: Path, data: bytes) -> VerifyResult:
     except SessionFileError as error:
         # Replay the intact lines before the bad one, for the counts and their last hash.
         good = b"".join(line + b"\n" for line in data.split(b"\n")[: error.line - 1])
+        intact: Replay | None = None
         try:
-            replay, lines, _ = (
-                replay_bytes(good, path, allow_torn=False) if good else (None, 0, None)
-            )
+            if good:
+                intact, lines, _ = replay_bytes(good, path, allow_torn=False)
+            else:
+                lines = 0
         except SessionFileError:
-            replay, lines = None, 0
+            intact, lines = None, 0
         return VerifyResult(
             ok=False,
             path=path,
             lines=lines,
-            events=len(replay.events) if replay else 0,
-            cycles=len(replay.cycles) if replay else 0,
-            last_hash=(replay.last_hash or "") if replay else "",
+            events=len(intact.events) if intact else 0,
+            cycles=len(intact.cycles) if intact else 0,
+            last_hash=(intact.last_hash or "") if intact else "",
             first_bad_line=error.line,
             message=f"NOT intact: line {error.line}: {error.fault}",
         )

@@ -203,7 +203,7 @@ class StationApp(App[int]):
         self.interrupt_session(name)
         # Textual's signature is exit(result, return_code): the code must go by name, or it
         # becomes the result and the process exits 0.
-        code = HANGUP_EXIT_CODES.get(signum, 1)
+        code = HANGUP_EXIT_CODES.get(signal.Signals(signum), 1)
         self.exit(code, return_code=code)
 
     def interrupt_session(self, reason: str) -> None:

@@ -51,11 +51,11 @@ async def run_autopilot(app: StationApp) -> None:
             screen.action_new()
         elif isinstance(screen, SetupScreen):
             await asyncio.sleep(step_pause)
-            if app.screen is screen:
+            if _still_shown(app, screen):
                 screen.action_start()
         elif isinstance(screen, ChecklistScreen):
             await asyncio.sleep(step_pause)
-            if app.screen is screen and not screen.busy:
+            if _still_shown(app, screen) and not screen.busy:
                 _fill_inputs(app, screen)
                 screen.action_confirm()
         elif isinstance(screen, StrokeDashboardScreen):
@@ -89,6 +89,12 @@ async def run_autopilot(app: StationApp) -> None:
                 screen.action_go_on()  # a block's cycles step: the next placement's steps
             else:
                 screen.action_finish()
+
+
+def _still_shown(app: StationApp, screen: object) -> bool:
+    """Whether ``screen`` is still the one shown (the pause before acting may have let the
+    operator or the engine move on)."""
+    return app.screen is screen
 
 
 def _fill_inputs(app: StationApp, screen: object) -> None:

@@ -145,7 +145,7 @@ def start_demo_fixture(
     )
     chosen = methods().get(method)
     rig = chosen.demo_rig(gauge, seed, stroke_points=stroke_points) if chosen else None
-    if rig is None:
+    if chosen is None or rig is None:
         chosen = BUILT_IN[0]
         rig = chosen.demo_rig(gauge, seed, stroke_points=stroke_points)
         assert rig is not None, "the default method has a simulated set-up"

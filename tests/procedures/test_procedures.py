@@ -362,3 +362,22 @@ def test_a_declared_analysis_kind_is_kept_and_validated(tmp_path: Path) -> None:
         text = HEAD.replace('unit = "in"', f'unit = "in"\nanalysis = "{kind}"') + body
         with pytest.raises(StationError, match=fault):
             load_procedure(write(tmp_path, text))
+
+
+def test_a_block_kind_with_a_zero_window_numbers_its_inner_steps_by_the_block(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The loader once reused the step's number for the zero's settle and still seconds, so a
+    # block kind that also takes a zero window numbered its inner steps "0.25.1", not "1.1".
+    from station.procedures import kinds
+
+    zeroed_repeat = kinds.StepSchema(block=True, zero_window=True)
+    monkeypatch.setattr(kinds, "_STEP_SCHEMAS", {**kinds._STEP_SCHEMAS, "zeroed": zeroed_repeat})
+    block_step = (
+        '[[steps]]\nid = "placements"\nkind = "zeroed"\ntitle = "Per placement"\n'
+        "target = 3\nsettle = 0.5\nstill = 0.25\n"
+        '[[steps.steps]]\nid = "read"\nkind = "check"\ntitle = "Read"\n'
+    )
+    (block,) = load_procedure(write(tmp_path, HEAD + block_step)).steps
+    assert (block.number, block.settle, block.still) == ("1", 0.5, 0.25)
+    assert [inner.number for inner in block.steps] == ["1.1"]

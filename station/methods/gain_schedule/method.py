@@ -70,13 +70,15 @@ class GainScheduleMethod(Method):
 
     def batch(self, inputs: MethodInputs) -> Judgement:
         """The fit of each gain against q (``order``: a fixed order, else chosen)."""
+        positions: Any
+        gains: Mapping[str, Any]
         if inputs.table is not None:
             table = inputs.table
             q = require_columns(table, ("q",), "a gains table")["q"]
             gains = {n: v for n, v in table.channels.items() if n.lower() != "q"}
             if not gains:
                 raise StationError(f"{table.path}: no gain columns beside q; add one per gain.")
-            positions: Any = q
+            positions = q
         else:
             positions, gains = gain_inputs(inputs.input_events)
         schedule = fit_schedule(positions, gains, inputs.option("order") or "auto")

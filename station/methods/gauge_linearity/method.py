@@ -13,7 +13,7 @@ import datetime as dt
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TextIO
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -52,6 +52,8 @@ from station.session.gauge_register import port_of, record_study, register_path
 from station.session.tables import require_columns
 
 if TYPE_CHECKING:
+    from _typeshed import SupportsWrite
+
     from station.analysis.summary import AnalysisConfig
     from station.instruments.simulator import GaugeSpec
     from station.session.model import Session
@@ -235,7 +237,7 @@ class GaugeLinearity(Method):
             bias_chart(judgement.result, references, values, kit),
         )
 
-    def write_wide(self, session: Session, out: TextIO) -> int:
+    def write_wide(self, session: Session, out: SupportsWrite[str]) -> int:
         """``cycle,reference,value``: each accepted reading with its master's size."""
         references, values = _readings(session_inputs(session_source(session)))
         numbers = [n for n in session.accepted_cycles if session.cycles[n].placement is not None]

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import csv
 from collections.abc import Iterator, Mapping, Sequence
-from typing import TYPE_CHECKING, Any, TextIO
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -28,6 +28,8 @@ from station.methods.tables import export_comments, number
 from station.procedures import AnalysisNeeds
 
 if TYPE_CHECKING:
+    from _typeshed import SupportsWrite
+
     from station.analysis.strokes import StrokeProfile
     from station.analysis.summary import AnalysisConfig
     from station.instruments.simulator import GaugeSpec
@@ -143,7 +145,7 @@ class Linearity(Method):
                 profile_chart(channel, result, profiles, unit, kit),
             )
 
-    def write_wide(self, session: Session, out: TextIO) -> int:
+    def write_wide(self, session: Session, out: SupportsWrite[str]) -> int:
         """The whole strokes as ``stroke,s,h,v``: one row per point, strokes numbered as the
         analysis numbers them (split and trimmed as it splits and trims them)."""
         export_comments(session, out)

@@ -119,7 +119,11 @@ class LiveStrokes:
         self._result: Any = None
 
     def add_cycle(
-        self, values: Mapping[str, float], cycle: int, times: Mapping[str, float] | None = None
+        self,
+        values: Mapping[str, float],
+        cycle: int,
+        times: Mapping[str, float] | None = None,
+        placement: int | None = None,
     ) -> Mapping[str, Any]:
         return {}
 

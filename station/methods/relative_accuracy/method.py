@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import csv
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any, TextIO
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -25,6 +25,8 @@ from station.procedures import AnalysisNeeds
 from station.session.tables import require_columns
 
 if TYPE_CHECKING:
+    from _typeshed import SupportsWrite
+
     from station.instruments.simulator import GaugeSpec
     from station.session.model import Session
     from station.session.tables import ReadingTable
@@ -123,7 +125,7 @@ class RelativeAccuracy(Method):
         """Captures at fixture placements (a file from before headers named the method)."""
         return any(cycle.placement is not None for cycle in session.cycles.values())
 
-    def write_wide(self, session: Session, out: TextIO) -> int:
+    def write_wide(self, session: Session, out: SupportsWrite[str]) -> int:
         """``cycle,placement,x,y,z`` of the accepted readings at fixture placements and, when
         every placement has them, the teach pendant's ``px,py,pz``."""
         _, _, pendant = session_accuracy_inputs(session)

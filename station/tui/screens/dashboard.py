@@ -83,7 +83,8 @@ class DashboardView:
             if last_cycle is not None and last_cycle.rejected is None
             else {}
         )
-        current = state.current
+        # A capture action always stands at a step; "" only keeps the line whole if not.
+        step_title = state.current.step.title if state.current is not None else ""
         counted = state.progress
         rejected = len(state.cycles) - len(accepted)
         if state.action.kind == "capture" and counted is not None:
@@ -91,7 +92,7 @@ class DashboardView:
             progress = f"{counted.noun} {counted.done} of {counted.target}"
             if not counted.enough:
                 progress += f" (at least {counted.minimum})"
-            prompt = (state.action.prompt or current.step.title) + (
+            prompt = (state.action.prompt or step_title) + (
                 "  The station captures each return of the robot."
                 if state.action.paced_by_devices
                 else "  Press Space to capture."
@@ -99,7 +100,7 @@ class DashboardView:
         elif state.action.kind == "capture":
             ready = False
             progress = f"{len(accepted)} captured"
-            prompt = f"{current.step.title}: {' '.join(state.action.prompt.split())}"
+            prompt = f"{step_title}: {' '.join(state.action.prompt.split())}"
             prompt = prompt.rstrip() + "  Press Space to capture."
         else:
             ready = True

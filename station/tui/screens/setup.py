@@ -18,6 +18,7 @@ from textual import events
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, VerticalScroll
+from textual.widget import Widget
 from textual.widgets import Button, Footer, Input, Select, Static
 
 from station.errors import StationError
@@ -295,15 +296,15 @@ class SetupScreen(ConnectionTestScreen):
         self._say("setup", f"{len(errors)} field(s) to correct above.")
         first_id = next(iter(errors))
         field = self.query_one(f"#{first_id}")
-        sentence = self.query_one(f"#{first_id}-error")
+        first_sentence = self.query_one(f"#{first_id}-error")
         field.focus(scroll_visible=False)
 
         def show_first() -> None:
             # Once the error lines are laid out: the field's whole row and its sentence.
             form = self.query_one("#setup-form", VerticalScroll)
-            row = field.parent if field.parent is not None else field
-            top = min(row.virtual_region.y, sentence.virtual_region.y)
-            bottom = sentence.virtual_region.bottom
+            row = field.parent if isinstance(field.parent, Widget) else field
+            top = min(row.virtual_region.y, first_sentence.virtual_region.y)
+            bottom = first_sentence.virtual_region.bottom
             if (
                 top < form.scroll_y
                 or bottom > form.scroll_y + form.scrollable_content_region.height

@@ -131,6 +131,8 @@ def read_setup(
     if errors:
         return None
     unit = value("unit")
+    # The method names the count's argument (cycles, placements or strokes).
+    count: dict[str, Any] = {count_field(procedure).setup_key: asked}
     return SessionSetup(
         procedure=procedure,
         robot=robot,
@@ -140,7 +142,7 @@ def read_setup(
         unit=unit,
         resolution=resolution,
         limits=limits,
-        **{count_field(procedure).setup_key: asked},
+        **count,
         # Live alarms test against the robot's baseline for this procedure and unit.
         baseline=header_baseline(robot, procedure.id, unit or procedure.unit),
     )

@@ -239,7 +239,7 @@ def _method(procedure: Procedure) -> Any:
 def count_field(procedure: Procedure) -> CountField:
     """What ``procedure``'s set-up counts (cycles, its block's placements, strokes), in its
     method's words."""
-    return _method(procedure).count_field(procedure)  # type: ignore[no-any-return]
+    return _method(procedure).count_field(procedure)
 
 
 def judged_channels(procedure: Procedure) -> list[str]:
@@ -262,7 +262,7 @@ def read_header(path: Path) -> dict[str, Any]:
     return dict(header) if isinstance(header, dict) else dict(vars(header))
 
 
-def recorded_summary(header: dict[str, Any]) -> Text:
+def recorded_summary(header: Mapping[str, Any]) -> Text:
     """What the file recorded, for the operator to check before resuming."""
     procedure = header.get("procedure", {})
     text = Text("Recorded set-up (kept as it was):\n", style="bold")

@@ -398,7 +398,7 @@ class SummaryScreen(Screen[None]):
         yield Static("", id="summary-message")
         yield Footer()
 
-    def notify(  # type: ignore[override]
+    def notify(
         self, message: str, *, severity: str = "information", markup: bool = True, **_: Any
     ) -> None:
         """Say ``message`` on the summary's own message line (a toast would cover the

@@ -65,7 +65,7 @@ def render_deviation(data: DeviationData | None, width: int, height: int) -> Tex
     grid = [[(" ", "")] * plot_width for _ in range(rows)]
     zero_row = cell(s_low, 0.0)[0]
     grid[zero_row] = [("─", "dim")] * plot_width
-    layers = [(t, EARLIER) for t in data.earlier]
+    layers: list[tuple[Trace | None, tuple[str, str]]] = [(t, EARLIER) for t in data.earlier]
     layers += [(data.newest, NEWEST), (data.current, CURRENT)]
     for trace, mark in layers:
         if trace is None:
