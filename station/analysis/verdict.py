@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Any
 
 from station.analysis.capability import Capability, readings_needed
 
@@ -142,7 +143,7 @@ def judge_verdict(capability: Capability, min_n: int = DEFAULT_MIN_N) -> Verdict
     shown = cpk_text(cpk, threshold)
     relation = ">=" if rule_capable else "<"
     lower, upper = capability.cpk_lower, capability.cpk_upper
-    settled = {
+    settled: dict[str, Any] = {
         "n": n,
         "min_n": min_n,
         "cpk": cpk,

@@ -132,7 +132,7 @@ def bounds_caption(rows: StatsRows) -> str:
         capability = getattr(rows.analyses.get(channel), "capability", None)
         lower = getattr(capability, "cpk_lower", None)
         upper = getattr(capability, "cpk_upper", None)
-        if lower is None or upper is None:
+        if capability is None or lower is None or upper is None:
             continue
         level = confidence_text(capability.confidence)
         shown.append(f"{shown_line(channel, limit=8)} {format_index(lower)}-{format_index(upper)}")
