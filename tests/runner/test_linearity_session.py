@@ -20,6 +20,7 @@ from station.session.model import load_session
 SEED = 5
 BAR = {"points": 100, "dwell": 6, "bow": 0.0015, "sag": 0.0008, "noise": 0.00002}
 STROKES = 25
+HOLD = 20
 
 
 def start_bar(*extra: str) -> tuple[subprocess.Popen, str]:
@@ -34,6 +35,9 @@ def start_bar(*extra: str) -> tuple[subprocess.Popen, str]:
         "--push-rate",
         "500",
         *(f"--{key}={value}" for key, value in BAR.items()),
+        # The robot stands at A from the simulator's first frame: long enough for a capture
+        # started on a loaded machine to check the frames and zero there (8 s was not).
+        f"--hold={HOLD}",
         *extra,
     )
 
