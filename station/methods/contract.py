@@ -37,10 +37,10 @@ if TYPE_CHECKING:
 Layout = Literal["tidy", "wide"]
 """A CSV export's layout: a row per reading (tidy) or the table the method's analysis reads."""
 
-OPTIONS = ("reference", "tolerance", "process_variation", "order")
+OPTIONS = ("reference", "tolerance", "process_variation", "order", "pool_above")
 """The values a command line may give a method's batch analysis (``station analyze``): a
-reference size, a tolerance, a process variation (6σ), a fit's order. A method names the ones it
-takes in :attr:`Method.options`."""
+reference size, a tolerance, a process variation (6σ), a fit's order, the p above which a Gage
+R&R pools its interaction. A method names the ones it takes in :attr:`Method.options`."""
 
 
 # -- what a method is given and gives back -----------------------------------------------------
@@ -274,6 +274,9 @@ class Method(ABC):
     """Whether its batch reads a CSV table by column name (linearity's stroke, s, h, v; a gains
     table's q) rather than each column as a channel: then no column is left out for counting
     the rows (``station analyze``), since 1, 2, 3 ... may be its own positions or joints."""
+    label_columns: ClassVar[tuple[str, ...]] = ()
+    """The columns of its CSV table that hold names, not numbers (a Gage R&R's part and
+    appraiser): ``station analyze`` keeps their cells as text (``ReadingTable.labels``)."""
     drift_chart: ClassVar[bool] = True
     """Whether its report draws the readings over time (cycles in time order; not strokes)."""
     files_in_register: ClassVar[bool] = False

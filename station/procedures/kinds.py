@@ -35,6 +35,9 @@ class StepSchema:
     """A block of inner ``steps`` repeated ``target`` times (no nesting)."""
     zero_window: bool = False
     """``readings``, ``settle`` and ``still``: a zero taken as the mean of several readings."""
+    parts: bool = False
+    """One reading of each of ``target`` numbered parts, in a random order drawn afresh each
+    time the step comes (a Gage R&R appraiser's trial)."""
 
     @property
     def allowed(self) -> tuple[str, ...]:

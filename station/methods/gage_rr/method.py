@@ -1,0 +1,220 @@
+"""The crossed Gage R&R as a method: the readings of one gauge, each of a part by an appraiser at
+a trial (a session's: the part a ``parts`` step recorded, the step's id as the appraiser, the
+repeated block's placement as the trial; a CSV's ``part,appraiser,trial,value`` rows, with
+``operator`` accepted for ``appraiser``), judged by
+:func:`~station.methods.gage_rr.study.gage_rr_study` against the tolerance typed at the
+session's input step (or ``--tolerance``). It judges no readings by capability: its verdict is
+its own (ACCEPTABLE, CONDITIONALLY ACCEPTABLE, NOT ACCEPTABLE or INCONCLUSIVE)."""
+
+from __future__ import annotations
+
+import csv
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any, TextIO
+
+import numpy as np
+
+from station.errors import StationError
+from station.methods.contract import Judgement, Method, MethodInputs, MethodVerdict, PlacementWords
+from station.methods.gage_rr.study import (
+    APPRAISERS_AIAG,
+    POOL_ABOVE,
+    TRIALS_AIAG,
+    GageRRStudy,
+    gage_rr_study,
+)
+from station.methods.live import LiveAboutGroups
+from station.methods.sessions import is_number, typed_values
+from station.methods.tables import export_comments, number
+from station.methods.text import fitted
+from station.procedures import AnalysisNeeds
+
+if TYPE_CHECKING:
+    from station.analysis.summary import AnalysisConfig
+    from station.session.model import Session
+
+NAME = "gage_rr"
+TABLE_COLUMNS = ("part", "appraiser", "trial", "value")
+"""The columns of its CSV table: one row per reading."""
+APPRAISER_ALIASES = ("appraiser", "operator")
+"""The names the appraiser's column may have (Minitab and others say operator)."""
+
+Readings = tuple[list[str], list[str], list[int], np.ndarray]
+"""The part, appraiser and trial of each reading, and the readings."""
+
+
+def _typed(inputs: MethodInputs, name: str) -> float | None:
+    """The command line's ``name``, else the session's typed one (None: neither)."""
+    given = inputs.option(name)
+    if given is None:
+        given = typed_values(inputs.input_events, name).get(name)
+    return float(given) if is_number(given) else None
+
+
+def _table_readings(inputs: MethodInputs) -> Readings:
+    """The rows of a ``part,appraiser,trial,value`` table (StationError naming a missing
+    column or a trial that is no whole number)."""
+    table = inputs.table
+    assert table is not None
+    labels = {name.lower(): cells for name, cells in table.labels.items()}
+    numbers = {name.lower(): values for name, values in table.channels.items()}
+    appraiser = next((labels[a] for a in APPRAISER_ALIASES if a in labels), None)
+    missing = [
+        name
+        for name, found in (
+            ("part", labels.get("part")),
+            ("appraiser", appraiser),
+            ("trial", numbers.get("trial")),
+            ("value", numbers.get("value")),
+        )
+        if found is None
+    ]
+    if missing:
+        have = ", ".join([*table.labels, *table.channels]) or "none"
+        raise StationError(
+            f"{table.path}: a Gage R&R table needs the columns {', '.join(TABLE_COLUMNS)} "
+            f"(operator for appraiser); {', '.join(missing)} missing (the file has {have})."
+        )
+    assert appraiser is not None
+    trials = numbers["trial"]
+    wrong = np.flatnonzero((trials != np.floor(trials)) | (trials < 1))
+    if wrong.size:
+        raise StationError(
+            f"{table.path}: trial {trials[wrong[0]]:g} of part {labels['part'][wrong[0]]} is "
+            "not a trial number (1, 2, 3 ...); fix the cell."
+        )
+    return (
+        list(labels["part"]),
+        list(appraiser),
+        [int(t) for t in trials],
+        numbers["value"],
+    )
+
+
+def _session_readings(session: Session) -> Readings:
+    """The accepted readings of the session's parts steps: the part each recorded, the step
+    (an appraiser's) and the placement (the trial) it was taken at."""
+    numbers = [
+        n
+        for n in session.accepted_cycles
+        if session.cycles[n].part is not None and session.cycles[n].placement is not None
+    ]
+    if not numbers:
+        raise StationError(
+            f"{session.path}: the session has no accepted reading of a part by an appraiser yet."
+        )
+    channel = session.channels[0]
+    cycles = [session.cycles[n] for n in numbers]
+    if any(channel not in cycle.readings for cycle in cycles):
+        raise StationError(f"{session.path}: a reading of a part has no value of {channel}.")
+    return (
+        [str(cycle.part) for cycle in cycles],
+        [cycle.step for cycle in cycles],
+        [int(cycle.placement or 0) for cycle in cycles],
+        np.asarray([cycle.readings[channel].value for cycle in cycles], dtype=float),
+    )
+
+
+def _names(inputs: MethodInputs, appraisers: Sequence[str]) -> dict[str, str]:
+    """The appraisers' names typed in the session (a field named by an appraiser's step id)."""
+    names: dict[str, str] = {}
+    for event in inputs.input_events:
+        for key, value in dict(event.get("values") or {}).items():
+            if key in appraisers and isinstance(value, str) and value.strip():
+                names[key] = value.strip()
+    return names
+
+
+class GageRR(Method):
+    """A crossed Gage R&R study of one gauge (see the module)."""
+
+    name = NAME
+    title = "GAGE R&R (CROSSED) REPORT"
+    reads_columns_by_name = True
+    label_columns = ("part", *APPRAISER_ALIASES)
+    needs = AnalysisNeeds(
+        facet="parts",
+        facet_in_block=True,
+        facet_words="a repeat block (one per trial) holding a parts step per appraiser",
+        limits=False,
+    )
+    json_key = NAME
+    options = ("tolerance", "pool_above")
+    export_layout = "wide"
+    drift_chart = False
+    placement_words = PlacementWords(
+        label="Trials",
+        noun="trials",
+        hint=f"trials: every appraiser measures every part once per trial; AIAG asks for "
+        f"{TRIALS_AIAG} with {APPRAISERS_AIAG} appraisers ({{low}} to {{target}})",
+        too_few="Give at least 2 trials: repeatability needs a part measured twice.",
+    )
+
+    def live(
+        self, config: AnalysisConfig, channels: Sequence[str], header: Mapping[str, Any]
+    ) -> LiveAboutGroups:
+        """The readings about their part's mean (the gauge's and the appraisers' variation)."""
+        return LiveAboutGroups(config, channels, header, by="part", what="part")
+
+    def study(self, inputs: MethodInputs) -> GageRRStudy:
+        """The study of ``inputs`` (StationError naming what is missing)."""
+        if inputs.table is not None:
+            parts, appraisers, trials, values = _table_readings(inputs)
+        else:
+            assert inputs.session is not None
+            parts, appraisers, trials, values = _session_readings(inputs.session)
+        rule = dict((inputs.header or {}).get(NAME) or {})
+        pool_above = inputs.option("pool_above")
+        if pool_above is None:
+            pool_above = rule.get("pool_above", POOL_ABOVE)
+        return gage_rr_study(
+            parts,
+            appraisers,
+            trials,
+            values,
+            tolerance=_typed(inputs, "tolerance"),
+            pool_above=float(pool_above) if is_number(pool_above) else POOL_ABOVE,
+            resolution=inputs.config.resolution,
+            unit=inputs.config.unit,
+            names=_names(inputs, tuple(dict.fromkeys(appraisers))),
+        )
+
+    def batch(self, inputs: MethodInputs) -> Judgement:
+        """The study and its verdict (no capability analysis)."""
+        study = self.study(inputs)
+        verdict = MethodVerdict(study.verdict, study.sentence, study.acceptable)
+        return Judgement(None, study, (fitted(study.lines(), inputs.width),), verdict)
+
+    def json(self, result: Any) -> dict[str, Any]:
+        """The study's figures: ``anova``, ``xbar_r``, the verdict and the design."""
+        return result.as_json()
+
+    def count(self, result: Any) -> str:
+        """``3 appraisers x 10 parts x 3 trials``."""
+        return (
+            f"{len(result.appraisers)} appraisers x {len(result.parts)} parts x "
+            f"{result.trials} trials"
+        )
+
+    def header_fields(self, fields: Mapping[str, Any]) -> dict[str, Any]:
+        """The pooling rule the session's verdict takes (kept with it: a later station with
+        another default judges the file as it was judged)."""
+        return {NAME: {"pool_above": POOL_ABOVE}}
+
+    def write_wide(self, session: Session, out: TextIO) -> int:
+        """``cycle,part,appraiser,trial,value``: each accepted reading of a part."""
+        parts, appraisers, trials, values = _session_readings(session)
+        numbers = [
+            n
+            for n in session.accepted_cycles
+            if session.cycles[n].part is not None and session.cycles[n].placement is not None
+        ]
+        export_comments(session, out)
+        writer = csv.writer(out, lineterminator="\n")
+        writer.writerow(("cycle", *TABLE_COLUMNS))
+        for row in zip(numbers, parts, appraisers, trials, values.tolist(), strict=True):
+            writer.writerow((*row[:4], number(row[4])))
+        return len(numbers)
+
+
+METHOD = GageRR()
