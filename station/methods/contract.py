@@ -121,7 +121,9 @@ class LiveVerdict(Protocol):
     ) -> Mapping[str, Any]:
         """Take one accepted cycle (``times``: each reading's time; ``placement``: the
         repeated block's placement it was taken at, None outside one); per channel an update
-        whose ``alarms`` are new."""
+        whose ``alarms`` are new. A cycle of a ``parts`` step comes with the keyword ``part``
+        (the part it measured): the live analysis of a method whose procedures present parts
+        takes it."""
         ...
 
     def add_stroke(self, outcome: Any) -> None:
@@ -137,8 +139,9 @@ class LiveVerdict(Protocol):
         ...
 
     def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveVerdict:
-        """A fresh live analysis of ``cycles`` (values, number, times, placement) keeping what
-        is not a cycle (strokes), or taking that from ``session`` when given (resume)."""
+        """A fresh live analysis of ``cycles`` (values, number, times, placement, part)
+        keeping what is not a cycle (strokes), or taking that from ``session`` when given
+        (resume)."""
         ...
 
     def copy(self) -> LiveCopy:

@@ -59,6 +59,7 @@ _STEP_SCHEMAS: dict[str, StepSchema] = {
     "zero": StepSchema(channels=True, zero_window=True),
     "capture": StepSchema(channels=True),
     "cycles": StepSchema(channels=True, counts=True),
+    "parts": StepSchema(channels=True, counts=True, parts=True),
     "stroke": StepSchema(channels=True, counts=True, direction=True),
     "repeat": StepSchema(block=True),
 }

@@ -104,3 +104,21 @@ def test_a_table_it_cannot_analyse_is_one_line_naming_what_is_missing(
     assert done.returncode == 2, done.stdout
     assert message in done.stderr
     assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr
+
+
+def test_names_from_the_table_are_text(tmp_path: Path):
+    """An appraiser's name with control characters reaches the terminal made visible."""
+    rows = [
+        (part, "A" if appraiser == "A" else "B\x1b]0;pwned\x07", trial, value)
+        for part, appraiser, trial, value in aiag_rows()
+        if appraiser != "C"
+    ]
+    path = write(tmp_path / "names.csv", rows)
+    done = run_station("analyze", path, "--procedure", "gage_rr")
+    assert done.returncode == 0, done.stderr
+    assert "\x1b" not in done.stdout and "\x07" not in done.stdout
+    assert "B\\x1b]0;pwned\\x07" in done.stdout
+    missing = write(tmp_path / "missing.csv", rows[:-1])
+    refused = run_station("analyze", missing, "--procedure", "gage_rr")
+    assert refused.returncode == 2 and "\x1b" not in refused.stderr
+    assert "part 10 by appraiser B\\x1b]0;pwned\\x07 has no trial 3" in refused.stderr

@@ -10,12 +10,21 @@ from __future__ import annotations
 
 import csv
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any, TextIO
 
 import numpy as np
 
 from station.errors import StationError
-from station.methods.contract import Judgement, Method, MethodInputs, MethodVerdict, PlacementWords
+from station.methods.contract import (
+    DemoDisplay,
+    DemoRig,
+    Judgement,
+    Method,
+    MethodInputs,
+    MethodVerdict,
+    PlacementWords,
+)
 from station.methods.gage_rr.study import (
     APPRAISERS_AIAG,
     POOL_ABOVE,
@@ -31,6 +40,7 @@ from station.procedures import AnalysisNeeds
 
 if TYPE_CHECKING:
     from station.analysis.summary import AnalysisConfig
+    from station.instruments.simulator import GaugeSpec
     from station.session.model import Session
 
 NAME = "gage_rr"
@@ -41,6 +51,15 @@ APPRAISER_ALIASES = ("appraiser", "operator")
 
 Readings = tuple[list[str], list[str], list[int], np.ndarray]
 """The part, appraiser and trial of each reading, and the readings."""
+DEMO_PARTS = (0.2480, 0.2512, 0.2497, 0.2525, 0.2469, 0.2503, 0.2538, 0.2490, 0.2516, 0.2476)
+"""The demo bench's ten parts (in): a process of about ±0.003 in about 0.25 in."""
+DEMO_APPRAISERS = {"A": 0.0, "B": 0.0001, "C": -0.00008}
+"""How the demo's appraisers read (in): B a tenth high, C a little low."""
+DEMO_NOISE = 0.00008
+"""The demo gauge's repeatability (σ, in): with the appraisers, about 10 % GRR."""
+DEMO_GAUGE = "DEMO-IND-1"
+DEMO_TOLERANCE = 0.006
+DEMO_NAMES = {"A": "Ann", "B": "Bo", "C": "Cy"}
 
 
 def _typed(inputs: MethodInputs, name: str) -> float | None:
@@ -125,6 +144,20 @@ def _names(inputs: MethodInputs, appraisers: Sequence[str]) -> dict[str, str]:
     return names
 
 
+def _bench_display(model: Any, placement: int | None, unit: str) -> DemoDisplay | None:
+    """What the simulated bench's label says at the study's input step: the gauge's id, the
+    tolerance and the appraisers' names."""
+    if placement is not None:
+        return None
+    names = ", ".join(f"{a} {n}" for a, n in DEMO_NAMES.items())
+    return DemoDisplay(
+        label="Gauge and appraisers (simulated)",
+        text=f"indicator {DEMO_GAUGE}, tolerance {DEMO_TOLERANCE:g} {unit}; appraisers {names}",
+        values={"gauge": DEMO_GAUGE, "tolerance": DEMO_TOLERANCE, **DEMO_NAMES},
+        hint="type the indicator's id, the tolerance and the appraisers' names shown above",
+    )
+
+
 class GageRR(Method):
     """A crossed Gage R&R study of one gauge (see the module)."""
 
@@ -149,6 +182,7 @@ class GageRR(Method):
         f"{TRIALS_AIAG} with {APPRAISERS_AIAG} appraisers ({{low}} to {{target}})",
         too_few="Give at least 2 trials: repeatability needs a part measured twice.",
     )
+    demo_words = "an indicator over a surface plate, ten parts and three appraisers"
 
     def live(
         self, config: AnalysisConfig, channels: Sequence[str], header: Mapping[str, Any]
@@ -215,6 +249,20 @@ class GageRR(Method):
         for row in zip(numbers, parts, appraisers, trials, values.tolist(), strict=True):
             writer.writerow((*row[:4], number(row[4])))
         return len(numbers)
+
+    def demo_rig(self, gauge: GaugeSpec, seed: int, *, stroke_points: int) -> DemoRig:
+        """An indicator over a surface plate, ten parts about 0.25 in and three appraisers,
+        B reading a little high and C a little low: about 10 % GRR."""
+        from station.instruments.gauge_bench import GageRRBenchModel
+
+        bench = replace(gauge, low=-0.5, high=1.0)
+        model = GageRRBenchModel(DEMO_PARTS, DEMO_APPRAISERS, noise=DEMO_NOISE, gauge=bench)
+        return DemoRig(
+            model,
+            "a simulated indicator over a surface plate, ten parts and three appraisers (seeded)",
+            channel_map={"1": "x"},
+            display=_bench_display,
+        )
 
 
 METHOD = GageRR()

@@ -66,6 +66,7 @@ import numpy as np
 
 from station.analysis.constants import chart_factors, d2, d3
 from station.errors import StationError
+from station.plain import plain
 
 POOL_ABOVE = 0.25
 """The interaction's p above which it is pooled into repeatability (AIAG, Minitab)."""
@@ -346,7 +347,8 @@ class GageRRStudy:
     def appraiser_label(self, appraiser: str) -> str:
         """``A`` or ``A (Ann)``."""
         name = self.names.get(appraiser, "").strip()
-        return f"{appraiser} ({name})" if name and name != appraiser else appraiser
+        shown = _shown(appraiser)
+        return f"{shown} ({_shown(name)})" if name and name != appraiser else shown
 
     def as_json(self) -> dict[str, Any]:
         """``station analyze --procedure gage_rr --json``'s ``gage_rr``."""
@@ -434,10 +436,10 @@ class GageRRStudy:
             f"  PV  = R_p·K3 = {_g(xr.part_range)}·{xr.k3:.4f} = {_g(xr.pv)}"
             f"   %PV  {_pct(xr.pct(xr.pv))}",
             f"  TV  = √(GRR² + PV²) = {_g(xr.tv)}   ndc = {_ndc_text(xr.ndc)}",
-            "  appraiser  average       R̄",
+            "  appraiser    average       R̄",
         ]
         lines.extend(
-            f"  {self.appraiser_label(a):<9}{_g(mean):>9}{_g(rbar):>9}"
+            f"  {self.appraiser_label(a):<9}{mean:>11.6g}{_g(rbar):>9}"
             for a, mean, rbar in zip(
                 self.appraisers, xr.appraiser_means, xr.appraiser_rbar, strict=True
             )
@@ -471,7 +473,8 @@ class GageRRStudy:
             notes.append("average and range: (X̄diff·K2)² is below EV²/(n·r), so AV is taken as 0.")
         for part, appraiser, value in self.xbar_r.ranges_out:
             notes.append(
-                f"the range of part {part} by appraiser {appraiser} ({_g(value)}) is above "
+                f"the range of part {_shown(part)} by appraiser {_shown(appraiser)} "
+                f"({_g(value)}) is above "
                 f"UCL_R {_g(self.xbar_r.ucl_r)}: AIAG has it measured again (or the cause found)."
             )
         if self.resolution is not None and 0 < self.anova.tv < 10 * self.resolution:
@@ -480,6 +483,12 @@ class GageRRStudy:
                 f"study variation {_g(self.anova.tv)}: it cannot resolve these parts well."
             )
         return notes
+
+
+def _shown(label: object) -> str:
+    """A part's or an appraiser's name as the report shows it: text from outside, with its
+    control characters made visible and a long one cut."""
+    return plain(label, limit=40)
 
 
 def _g(value: float | None) -> str:
@@ -548,32 +557,36 @@ def _design(
     ):
         if not math.isfinite(value):
             raise StationError(
-                f"the reading of part {part} by appraiser {appraiser}, trial {trial} is not a "
+                f"the reading of part {_shown(part)} by appraiser {_shown(appraiser)}, trial "
+                f"{_shown(trial)} is not a "
                 "finite number; fix or drop it."
             )
         cell = cells.setdefault((part, appraiser), {})
         if trial in cell:
             raise StationError(
-                f"part {part} by appraiser {appraiser} has trial {trial} twice; each trial is "
+                f"part {_shown(part)} by appraiser {_shown(appraiser)} has trial "
+                f"{_shown(trial)} twice; each trial is "
                 "one reading of each part by each appraiser."
             )
         cell[trial] = value
     part_order, appraiser_order = _ordered(part_labels), _ordered(appraiser_labels)
     if len(appraiser_order) < 2:
         raise StationError(
-            f"a Gage R&R needs 2 or more appraisers; the readings name 1 ({appraiser_order[0]}):"
+            f"a Gage R&R needs 2 or more appraisers; the readings name 1 "
+            f"({_shown(appraiser_order[0])}):"
             f" AIAG asks for {APPRAISERS_AIAG}, each measuring every part."
         )
     if len(part_order) < 2:
         raise StationError(
-            f"a Gage R&R needs 2 or more parts; the readings name 1 ({part_order[0]}): AIAG "
-            f"asks for {PARTS_AIAG} spanning the process range."
+            f"a Gage R&R needs 2 or more parts; the readings name 1 "
+            f"({_shown(part_order[0])}): AIAG asks for {PARTS_AIAG} spanning the process range."
         )
     for part in part_order:
         missing = [a for a in appraiser_order if (part, a) not in cells]
         if missing:
             raise StationError(
-                f"part {part} was not measured by appraiser {', '.join(missing)}: in a crossed "
+                f"part {_shown(part)} was not measured by appraiser "
+                f"{', '.join(map(_shown, missing))}: in a crossed "
                 "study every appraiser measures every part (measure it, or leave the part out)."
             )
     every = sorted({t for cell in cells.values() for t in cell}, key=_trial_key)
@@ -582,7 +595,7 @@ def _design(
             lacking = [t for t in every if t not in cells[(part, appraiser)]]
             if lacking:
                 raise StationError(
-                    f"part {part} by appraiser {appraiser} has no trial "
+                    f"part {_shown(part)} by appraiser {_shown(appraiser)} has no trial "
                     f"{', '.join(map(str, lacking))} (the others have trials "
                     f"{', '.join(map(str, every))}): measure it, or leave that trial out for "
                     "every part (the design must be balanced)."
