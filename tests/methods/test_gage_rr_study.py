@@ -294,3 +294,42 @@ def test_the_report_labels_both_methods():
     # Its tables fit the TUI summary's 74 columns unwrapped; the sentences wrap to it.
     tables = [line for line in text.splitlines() if "6·SD" in line or "  part" in line]
     assert tables and all(len(line) <= 74 for line in tables)
+
+
+class Kit:
+    """The chart kit a report gives a method (station.record.charts), in its simplest form."""
+
+    point, centre, limit, alarm = "C0", "black", "red", "magenta"
+
+    def figure(self, width: float = 7.0, height: float = 3.2):
+        from matplotlib.figure import Figure
+
+        return Figure(figsize=(width, height))
+
+    def label(self, text: object) -> str:
+        return str(text)
+
+
+def test_the_charts_draw_the_studys_figures():
+    from station.methods.gage_rr import charts
+
+    study = gage_rr_study(*rows(AIAG), names={"A": "Ann"})
+    cells = study.data.mean(axis=2)
+    interaction = charts.interaction_chart(study, Kit()).axes[0]
+    lines = {line.get_label(): line.get_ydata() for line in interaction.get_lines()}
+    assert set(lines) == {"A (Ann)", "B", "C"}
+    for j, label in enumerate(("A (Ann)", "B", "C")):
+        assert np.allclose(lines[label], cells[:, j])
+    assert "p = 0.974, pooled" in interaction.get_title()
+    ranges = charts.range_chart(study, Kit()).axes[0]
+    levels = {line.get_label(): line.get_ydata()[0] for line in ranges.get_lines()[-2:]}
+    assert levels == pytest.approx({"R̄̄ 0.3417": 0.341667, "UCL 0.8797": 0.879652}, abs=1e-6)
+    # Appraiser B's range on part 4, beyond UCL_R, is flagged where B's ranges run (10 + 4).
+    (flagged,) = ranges.collections
+    assert flagged.get_offsets().tolist() == [[14.0, pytest.approx(1.02)]]
+    by_part = charts.by_part_chart(study, Kit()).axes[0]
+    means = next(line for line in by_part.get_lines() if line.get_label() == "part mean")
+    assert np.allclose(means.get_ydata(), study.data.mean(axis=(1, 2)))
+    by_appraiser = charts.by_appraiser_chart(study, Kit()).axes[0]
+    tick_labels = [tick.get_text() for tick in by_appraiser.get_xticklabels()]
+    assert tick_labels == ["A (Ann)", "B", "C"]

@@ -8,6 +8,7 @@ table ``station analyze --procedure gage_rr`` reads back to the same figures."""
 from __future__ import annotations
 
 import json
+import os
 import re
 import subprocess
 from dataclasses import dataclass, field
@@ -20,6 +21,7 @@ from scipy import stats
 from station.instruments.gauge_bench import GageRRBenchModel
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import GaugeSpec, Simulator
+from station.session.gauge_register import load_register
 from station.session.model import load_session
 
 PACE = "0.15"
@@ -147,3 +149,22 @@ def test_a_gage_rr_study_headless_recovers_the_appraisers_and_the_gauge(tmp_path
     again = run_station("analyze", table, "--procedure", "gage_rr", "--tolerance", "0.02", "--json")
     assert again.returncode == 0, again.stderr
     assert json.loads(again.stdout)["gage_rr"]["anova"] == pytest.approx(anova)
+    # Finished, the study filed itself in the gauge register beside the gauge's checks.
+    word = study["verdict"]
+    assert f"Gage R&R of MIT-0042: {word} on " in text
+    register = load_register(Path(os.environ["STATION_GAUGES"]))
+    (entry,) = register["gauges"]["MIT-0042"]["studies"]["gage_rr"]
+    assert entry["result"] == word.lower() and entry["ndc"] == anova["ndc"]
+    assert entry["pct_grr"] == pytest.approx(anova["pct_grr"])
+    assert entry["appraisers"] == ["A", "B", "C"] and entry["trials"] == TRIALS
+    assert entry["port"] == {"url": simulator.url, "device": "1"}
+    listed = run_station("gauges", "list")
+    assert f"  gage_rr: {word.lower()} on " in listed.stdout
+    # Its report draws the four charts of the study.
+    html = tmp_path / "grr.html"
+    reported = run_station("report", path, "--format", "html", "-o", html)
+    assert reported.returncode == 0, reported.stderr
+    page = html.read_text()
+    for caption in ("Readings by part", "Readings by appraiser", "Part x appraiser interaction",
+                    "Range chart by appraiser"):  # fmt: skip
+        assert caption in page

@@ -4,19 +4,25 @@ repeated block's placement as the trial; a CSV's ``part,appraiser,trial,value`` 
 ``operator`` accepted for ``appraiser``), judged by
 :func:`~station.methods.gage_rr.study.gage_rr_study` against the tolerance typed at the
 session's input step (or ``--tolerance``). It judges no readings by capability: its verdict is
-its own (ACCEPTABLE, CONDITIONALLY ACCEPTABLE, NOT ACCEPTABLE or INCONCLUSIVE)."""
+its own (ACCEPTABLE, CONDITIONALLY ACCEPTABLE, NOT ACCEPTABLE or INCONCLUSIVE). Its report draws
+the readings by part and by appraiser, the interaction and the range chart; a finished study
+files itself in the gauge register under the gauge id typed in it, beside the gauge's checks."""
 
 from __future__ import annotations
 
 import csv
-from collections.abc import Mapping, Sequence
+import datetime as dt
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import replace
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
 import numpy as np
 
 from station.errors import StationError
 from station.methods.contract import (
+    Chart,
+    ChartKit,
     DemoDisplay,
     DemoRig,
     Judgement,
@@ -24,6 +30,12 @@ from station.methods.contract import (
     MethodInputs,
     MethodVerdict,
     PlacementWords,
+)
+from station.methods.gage_rr.charts import (
+    by_appraiser_chart,
+    by_part_chart,
+    interaction_chart,
+    range_chart,
 )
 from station.methods.gage_rr.study import (
     APPRAISERS_AIAG,
@@ -33,10 +45,16 @@ from station.methods.gage_rr.study import (
     gage_rr_study,
 )
 from station.methods.live import LiveAboutGroups
-from station.methods.sessions import is_number, typed_values
+from station.methods.sessions import (
+    is_number,
+    load_session_source,
+    session_inputs,
+    typed_values,
+)
 from station.methods.tables import export_comments, number
 from station.methods.text import fitted
 from station.procedures import AnalysisNeeds
+from station.session.gauge_register import port_of, record_study, register_path
 
 if TYPE_CHECKING:
     from station.analysis.summary import AnalysisConfig
@@ -175,6 +193,7 @@ class GageRR(Method):
     options = ("tolerance", "pool_above")
     export_layout = "wide"
     drift_chart = False
+    files_in_register = True
     placement_words = PlacementWords(
         label="Trials",
         noun="trials",
@@ -234,6 +253,54 @@ class GageRR(Method):
         """The pooling rule the session's verdict takes (kept with it: a later station with
         another default judges the file as it was judged)."""
         return {NAME: {"pool_above": POOL_ABOVE}}
+
+    def charts(self, inputs: MethodInputs, judgement: Judgement, kit: ChartKit) -> Iterator[Chart]:
+        """The readings by part and by appraiser, the interaction, the range chart."""
+        study = judgement.result
+        yield "by-part", "Readings by part", by_part_chart(study, kit)
+        yield "by-appraiser", "Readings by appraiser", by_appraiser_chart(study, kit)
+        yield "interaction", "Part x appraiser interaction", interaction_chart(study, kit)
+        yield "range-chart", "Range chart by appraiser", range_chart(study, kit)
+
+    def file_in_register(self, path: Path, register: Path | None = None) -> list[str]:
+        """File the study under the gauge id typed in the session, beside its checks."""
+        source = load_session_source(path)
+        session = source.session
+        study = self.study(session_inputs(source))
+        gauge = str(typed_values(session.input_events, "gauge").get("gauge") or "").strip()
+        if not gauge:
+            raise StationError(f"{session.path}: the study names no gauge id to register.")
+        target = register or register_path()
+        anova = study.anova
+        pct = anova.pct_grr
+        summary = f"%GRR {pct:.1f} %, ndc {anova.ndc}" if pct is not None else "no variation"
+        entry = record_study(
+            target,
+            gauge,
+            NAME,
+            {
+                "date": dt.date.fromisoformat(str(session.created)[:10]).isoformat(),
+                "result": study.verdict.lower(),
+                "summary": summary,
+                "pct_grr": pct,
+                "pct_tolerance": anova.pct_tolerance,
+                "ndc": anova.ndc,
+                "ev": anova.ev,
+                "av": anova.av,
+                "grr": anova.grr,
+                "pv": anova.pv,
+                "tolerance": study.tolerance,
+                "appraisers": list(study.appraisers),
+                "parts": len(study.parts),
+                "trials": study.trials,
+                "session": session.session_id,
+            },
+            port=port_of(session.header, next(iter(source.channels), "x")),
+        )
+        return [
+            f"Gage R&R of {gauge}: {study.verdict} on {entry['date']} ({summary}); filed in "
+            f"the gauge register {target}."
+        ]
 
     def write_wide(self, session: Session, out: TextIO) -> int:
         """``cycle,part,appraiser,trial,value``: each accepted reading of a part."""
