@@ -333,3 +333,21 @@ def test_the_charts_draw_the_studys_figures():
     by_appraiser = charts.by_appraiser_chart(study, Kit()).axes[0]
     tick_labels = [tick.get_text() for tick in by_appraiser.get_xticklabels()]
     assert tick_labels == ["A (Ann)", "B", "C"]
+
+
+def test_the_procedure_counts_trials_and_asks_for_two_at_least():
+    """The built-in procedure: a trial block holding a parts step per appraiser (A, B, C) of
+    ten parts; the set-up counts trials, 3 by default and never fewer than 2."""
+    from station.methods import method_of
+    from station.procedures import discover_procedures
+
+    procedure = discover_procedures(use_env=False).get("gage_rr")
+    assert procedure.analysis == "gage_rr"
+    (block,) = [step for step in procedure.steps if step.kind == "repeat"]
+    parts = [step for step in block.steps if step.kind == "parts"]
+    assert [(s.id, s.count_target) for s in parts] == [("A", 10), ("B", 10), ("C", 10)]
+    count = method_of("gage_rr").count_field(procedure)
+    assert (count.label, count.setup_key, count.target, count.minimum) == (
+        "Trials", "placements", 3, 2,
+    )  # fmt: skip
+    assert "AIAG asks for 3 with 3 appraisers" in count.hint

@@ -23,6 +23,7 @@ from station.errors import StationError
 from station.methods.contract import (
     Chart,
     ChartKit,
+    CountField,
     DemoDisplay,
     DemoRig,
     Judgement,
@@ -53,7 +54,7 @@ from station.methods.sessions import (
 )
 from station.methods.tables import export_comments, number
 from station.methods.text import fitted
-from station.procedures import AnalysisNeeds
+from station.procedures import AnalysisNeeds, Procedure
 from station.session.gauge_register import port_of, record_study, register_path
 
 if TYPE_CHECKING:
@@ -202,6 +203,11 @@ class GageRR(Method):
         too_few="Give at least 2 trials: repeatability needs a part measured twice.",
     )
     demo_words = "an indicator over a surface plate, ten parts and three appraisers"
+
+    def count_field(self, procedure: Procedure) -> CountField:
+        """The trials (the placements of its block): 2 at least, since one trial shows no
+        repeatability."""
+        return replace(super().count_field(procedure), minimum=2)
 
     def live(
         self, config: AnalysisConfig, channels: Sequence[str], header: Mapping[str, Any]
