@@ -306,6 +306,7 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
                         rejected=session.rejected.get(number),
                         resolution=self.setup.resolved_resolution,
                         times=cycle_times(list(cycle.readings), {"t": cycle.t}),
+                        part=cycle.part,
                     )
                 )
             self._next_cycle = session.next_cycle
@@ -557,7 +558,7 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
             self._accepted_by_step[key] = self._accepted_by_step.get(key, 0) + 1
         self._accepted_count = len(accepted)
         self._live = self._live.rebuilt(
-            [(r.values, r.cycle, r.times, r.placement) for r in accepted], session
+            [(r.values, r.cycle, r.times, r.placement, r.part) for r in accepted], session
         )
         self._live_changed()
 
@@ -574,7 +575,7 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
         # alarms are on disk already: what the feeding raises again is not recorded twice.
         for record in self._cycles:
             if record.rejected is None:
-                self._live.add_cycle(record.values, record.cycle, record.times, record.placement)
+                self.feed_live(record)
         self._live_changed()
 
     def _zero_config(self) -> bool:
