@@ -15,7 +15,7 @@ import datetime as dt
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TextIO
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -58,6 +58,8 @@ from station.procedures import AnalysisNeeds, Procedure
 from station.session.gauge_register import port_of, record_study, register_path
 
 if TYPE_CHECKING:
+    from _typeshed import SupportsWrite
+
     from station.analysis.summary import AnalysisConfig
     from station.instruments.simulator import GaugeSpec
     from station.session.model import Session
@@ -308,7 +310,7 @@ class GageRR(Method):
             f"the gauge register {target}."
         ]
 
-    def write_wide(self, session: Session, out: TextIO) -> int:
+    def write_wide(self, session: Session, out: SupportsWrite[str]) -> int:
         """``cycle,part,appraiser,trial,value``: each accepted reading of a part."""
         parts, appraisers, trials, values = _session_readings(session)
         numbers = [
