@@ -123,6 +123,21 @@ def test_hang_up_during_capture_leaves_a_resumable_session(tmp_path: Path) -> No
     finally:
         second.close()
 
+    # The next demo resumes it on its own simulator (issue 26, item 4): the recorded
+    # pseudo-terminal went with the demo that hung up. The robot's returns are cycles again.
+    third = Pane(_station("demo", "--sessions", str(tmp_path)), tmp_path)
+    try:
+        third.wait_for("Resume:", timeout=30)
+        third._tmux("send-keys", "-t", third.name, "r")
+        third.wait_for("resumes on its own running simulator", timeout=30)
+        third._tmux("send-keys", "-t", third.name, "F2")
+        deadline = time.monotonic() + 30
+        while max(load_session(sessions[0], recover=False).cycles) == max(session.cycles):
+            assert time.monotonic() < deadline, f"no cycle after the resume:\n{third.screen()}"
+            time.sleep(0.2)
+    finally:
+        third.close()
+
 
 @pytest.mark.parametrize(
     ("procedure", "channels", "report", "minimum"),
