@@ -1,7 +1,7 @@
 """What several test modules share: ``station`` run in this process (:func:`run_station`, the
 fast default) or as a real subprocess (:data:`STATION`, where the process boundary is what the
 test is about), ``station simulate`` as a subprocess, and the small procedure files the
-procedure and capture tests write.
+procedure and capture tests write, and pseudo-terminals held as another program would.
 
 Imported as ``from helpers import ...``: pytest puts ``tests/`` on ``sys.path`` for the suite's
 own ``conftest.py``.
@@ -160,3 +160,38 @@ kind = "cycles"
 title = "Cycles"
 """
 """A procedure that is one cycles step (for tests about reading sets alone)."""
+
+
+class Terminal:
+    """A pseudo-terminal this test opened, as another program (an SSH login) holds one."""
+
+    def __init__(self, master: int, slave: int) -> None:
+        self.master, self.slave = master, slave
+        self.path = os.ttyname(slave)
+
+    def close(self) -> None:
+        os.close(self.slave)
+        os.close(self.master)
+
+
+def open_terminal(terminals: list[Terminal]) -> Terminal:
+    terminal = Terminal(*os.openpty())
+    terminals.append(terminal)
+    return terminal
+
+
+def reopen_number(path: str, terminals: list[Terminal]) -> Terminal:
+    """A new pseudo-terminal at ``path`` (closed just before): the kernel gives the lowest
+    free number, so the next ones opened get it back (those below it are held meanwhile)."""
+    held: list[Terminal] = []
+    try:
+        for _ in range(64):
+            terminal = Terminal(*os.openpty())
+            if terminal.path == path:
+                terminals.append(terminal)
+                return terminal
+            held.append(terminal)
+        raise AssertionError(f"another program took {path} before this test could")
+    finally:
+        for terminal in held:
+            terminal.close()

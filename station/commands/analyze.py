@@ -29,6 +29,7 @@ OPTION_FLAGS = {
     "reference": "--reference",
     "tolerance": "--tolerance",
     "process_variation": "--process-variation",
+    "pool_above": "--pool-above",
 }
 """The command line's values a method's analysis may take (its ``options``), by flag."""
 SUBGROUP_LIMIT = 1000
@@ -58,7 +59,10 @@ master with its t-test, its regression on the size, linearity = |slope|·PV with
 when given); --procedure joint_troubleshooting reads joint, x, y, z (and
 optionally lever: the joint's axis to the cube) and names the suspect joint;
 --procedure gain_schedule reads q and one column per gain (see also station
-gains fit). A session file is analysed as its procedure declares (its
+gains fit); --procedure gage_rr reads part, appraiser (or operator), trial,
+value (part and appraiser may be names) and gives the crossed Gage R&R by ANOVA
+and by average and range, %GRR against --tolerance T when given, ndc, and
+AIAG's verdict. A session file is analysed as its procedure declares (its
 `analysis`) unless --procedure says otherwise.
 
 exit codes:
@@ -66,7 +70,7 @@ exit codes:
   1  with --fail-if-incapable: a channel is NOT CAPABLE (its confidence bound
      is below the threshold), has no verdict (no limits) or only a provisional
      one (fewer readings than --min-n); a study with a verdict of its own
-     (gauge_linearity) is not ACCEPTABLE. An INCONCLUSIVE channel (its bounds
+     (gauge_linearity, gage_rr) is not ACCEPTABLE. An INCONCLUSIVE channel (its bounds
      straddle the threshold) passes, with a note on stderr; with
      --fail-if-inconclusive it fails too
   2  bad input: missing or empty file, a cell that is not a number, impossible
@@ -137,14 +141,20 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--tolerance",
         metavar="T",
         help="linearity: straightness tolerance, the zone width per stroke (default: the "
-        "session's, from its h/v limits); gauge_check, gauge_linearity: the tolerance T the "
-        "gauge will judge",
+        "session's, from its h/v limits); gauge_check, gauge_linearity, gage_rr: the tolerance "
+        "T the gauge will judge",
     )
     parser.add_argument(
         "--process-variation",
         metavar="PV",
         help="gauge_linearity: the process variation (6 sigma) the linearity is stated "
         "against (default: the session's, else the tolerance)",
+    )
+    parser.add_argument(
+        "--pool-above",
+        metavar="P",
+        help="gage_rr: pool the part x appraiser interaction into repeatability when its "
+        "p-value is above P (default: the session's, else 0.25 as AIAG)",
     )
     parser.add_argument(
         "--reference",
@@ -181,9 +191,9 @@ def is_session_file(path: Path) -> bool:
     return looks_like_session(first)
 
 
-def load_source(path: Path) -> Any:
+def load_source(path: Path, labels: tuple[str, ...] = ()) -> Any:
     """A session file (detected by its header: a ``SessionSource``) or a CSV table of readings
-    (a ``TableSource``)."""
+    (a ``TableSource``; ``labels``: the columns of names the method reads)."""
     from station.inputfiles import check_regular_file
 
     # A FIFO, a device, a folder or a name too long is refused before a byte is read.
@@ -194,7 +204,7 @@ def load_source(path: Path) -> Any:
         return load_session_source(path)
     from station.session.tables import read_table
 
-    table = read_table(path)
+    table = read_table(path, labels)
     cycles = None if table.cycles is None else dict.fromkeys(table.channels, table.cycles)
     if table.channel_cycles is not None:  # a tidy table: its own cycle numbers per channel
         cycles = dict(table.channel_cycles)
@@ -289,7 +299,21 @@ def run(args: argparse.Namespace) -> int:
         if min_n < 0:
             raise StationError(f"--min-n {min_n} must be 0 or more.")
 
-    source = load_source(path)
+    from station.inputfiles import check_regular_file
+    from station.methods import (
+        MethodInputs,
+        judge,
+        method_of,
+        names,
+        report_session,
+        session_method,
+    )
+
+    # A FIFO, a device, a folder or a name too long is refused before a byte is read. A table
+    # is judged by the method named (its label columns read as text), a session by its own.
+    check_regular_file(path, "file of readings")
+    table_method = None if is_session_file(path) else method_of(args.procedure or names()[0])
+    source = load_source(path, table_method.label_columns if table_method else ())
     channels = source.channels
     for channel, _, _ in per_channel:
         if channel not in channels:
@@ -319,17 +343,9 @@ def run(args: argparse.Namespace) -> int:
     freeze_after = bounded_int(args.freeze_after, "--freeze-after", 2, SUBGROUP_LIMIT)
     if freeze_after is not None:
         config = replace(config, freeze_after=freeze_after)
-    from station.methods import (
-        MethodInputs,
-        judge,
-        method_of,
-        names,
-        report_session,
-        session_method,
-    )
-
     if isinstance(source, TableSource):
-        method = method_of(args.procedure or names()[0])
+        assert table_method is not None
+        method = table_method
         if not method.reads_columns_by_name:
             source = without_row_counters(source)
             channels = source.channels
@@ -343,9 +359,13 @@ def run(args: argparse.Namespace) -> int:
         raise StationError(
             f"--process-variation {args.process_variation!r} must be greater than 0."
         )
+    pool_above = parse_number(args.pool_above, "--pool-above")
+    if pool_above is not None and not 0 < pool_above < 1:
+        raise StationError(f"--pool-above {args.pool_above!r} must be between 0 and 1.")
     options = method_options(
         method,
         {
+            "pool_above": pool_above,
             "reference": parse_number(args.reference, "--reference"),
             "tolerance": tolerance,
             "process_variation": variation,

@@ -36,7 +36,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "30 cycles; relative_accuracy: two fixtures and a teach pendant, a few placements; "
         "linearity: a parallel bar with indicators h, v and a linear scale s, 30 strokes; "
         "gauge_check: an indicator over a surface plate and a gauge block; gauge_linearity: "
-        "the same indicator and five gauge blocks over its travel. A gauge study the demo runs "
+        "the same indicator and five gauge blocks over its travel; gage_rr: the same indicator, "
+        "ten parts and three appraisers, one reading high and one low. A gauge study the demo runs "
         "is filed in the demo folder's own gauge register.",
     )
     parser.add_argument(
@@ -48,16 +49,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--procedure",
         default="repeatability",
         metavar="ID",
-        help="procedure id: repeatability, relative_accuracy, linearity, gauge_check or "
-        "gauge_linearity each have a simulated set-up; another runs against its method's, or "
+        help="procedure id: repeatability, relative_accuracy, linearity, gauge_check, "
+        "gauge_linearity or gage_rr each have a simulated set-up; another runs against its "
+        "method's, or "
         "the repeatability fixture (default: %(default)s)",
     )
     parser.add_argument(
         "--count",
         type=int,
         metavar="N",
-        help="cycles (repeatability), fixture placements (relative_accuracy) or strokes "
-        "(linearity) to pre-fill in the set-up (default: the procedure's)",
+        help="cycles (repeatability), fixture placements (relative_accuracy), strokes "
+        "(linearity) or trials (gage_rr) to pre-fill in the set-up (default: the procedure's)",
     )
     parser.add_argument(
         "--seed", type=int, default=1990, help="simulator seed (default: %(default)s)"

@@ -12,14 +12,14 @@ from station.errors import StationError
 DESCRIPTION = """\
 The gauge register: per gauge id or serial, the Type-1 gauge checks recorded
 (date, result, Cg, Cgk, bias), the other studies of the gauge (a linearity and
-bias study over its travel) and the calibration due date. It lives in
+bias study over its travel, a Gage R&R) and the calibration due date. It lives in
 $XDG_DATA_HOME/station/gauges.json (~/.local/share/station/gauges.json), or
 the file STATION_GAUGES names.
 
   station gauges list [--json]           every gauge and its status today
   station gauges status ID... [--json]   passed / failed / overdue / none
-  station gauges record SESSION.jsonl    file a finished gauge_check or
-                                         gauge_linearity session
+  station gauges record SESSION.jsonl    file a finished gauge_check,
+                                         gauge_linearity or gage_rr session
 
 A check is overdue when the calibration due date has passed or the check is
 older than 183 days (the report's "every four to six months").
@@ -46,10 +46,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     status.add_argument("--json", action="store_true", help="print one JSON document")
     status.set_defaults(func=run_status)
     record = actions.add_parser(
-        "record", help="file a finished gauge study (gauge_check, gauge_linearity) session"
+        "record", help="file a finished gauge study (gauge_check, gauge_linearity, gage_rr) session"
     )
     record.add_argument(
-        "session", metavar="SESSION.jsonl", help="a gauge_check or gauge_linearity session file"
+        "session",
+        metavar="SESSION.jsonl",
+        help="a gauge_check, gauge_linearity or gage_rr session file",
     )
     record.set_defaults(func=run_record)
     for action in (listing, status, record):
@@ -104,15 +106,16 @@ def run_status(args: argparse.Namespace) -> int:
 
 def run_record(args: argparse.Namespace) -> int:
     """File a finished gauge study session (its method says how) in the gauge register."""
-    from station.methods import method_of, session_method
+    from station.methods import method_of, methods, session_method
     from station.session.model import load_session
 
     session = load_session(Path(args.session), recover=False)
     method = method_of(session_method(session))
     if not method.files_in_register:
+        studies = ", ".join(m.name for m in methods().values() if m.files_in_register)
         raise StationError(
             f"{args.session} is a {method.name} session, which files nothing in the gauge "
-            "register; record a gauge study (gauge_check, gauge_linearity) session."
+            f"register; record a gauge study ({studies}) session."
         )
     if not session.finished:
         raise StationError(f"{args.session} is not finished; finish it before recording it.")

@@ -18,12 +18,15 @@ noisy one Cg; a slope shows in the linearity study.
 With several ``references`` the blocks come in turn, ``readings`` seatings each: seating r (1,
 2, ...) is of block ``(r − 1) // readings`` (the last one after that). :meth:`rest_of` names the
 rest of a block's seating, so a session can put the bench where its steps say.
+
+:class:`GageRRBenchModel` is the same bench for a Gage R&R: the blocks are the parts, seated in
+whatever order the operator is given, by appraisers who each read with an offset of their own.
 """
 
 from __future__ import annotations
 
 import random
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from station.errors import StationError
 from station.instruments.simulator import GaugeSpec, RobotModel
@@ -118,3 +121,66 @@ class GaugeBenchModel(RobotModel):
     def zero_reference(self, channel: str, rest: int, seed: int) -> float:
         """Zeroing on the surface plate: the indicator's zero is the plate."""
         return 0.0
+
+
+class GageRRBenchModel(GaugeBenchModel):
+    """The gauge bench for a Gage R&R: the ``references`` are the parts' sizes (part 1, 2 ...),
+    and each of the ``appraisers`` (by name, an offset each: an appraiser who reads high or
+    seats a part a little off) reads part p as
+
+        size_p + offset_appraiser + bias + slope · size_p + noise
+
+    with a fresh noise draw per seating. Who seats which part is the operator's business (the
+    procedure's random order): :meth:`rest_of_part` names the rest of a seating, so a session
+    puts the bench where its current step says (the plate at rest 0, as for the other studies).
+    """
+
+    def __init__(
+        self,
+        references: Sequence[float],
+        appraisers: Mapping[str, float],
+        *,
+        bias: float = 0.0,
+        slope: float = 0.0,
+        noise: float = 0.00003,
+        gauge: GaugeSpec = BENCH_INDICATOR,
+    ) -> None:
+        super().__init__(references, bias=bias, slope=slope, noise=noise, readings=1, gauge=gauge)
+        if not appraisers:
+            raise StationError("the Gage R&R bench needs at least one appraiser.")
+        self.appraisers = dict(appraisers)
+        self._names = tuple(self.appraisers)
+
+    @property
+    def cycles(self) -> None:
+        """Every seating is a part's, in the operator's order (no blocks of seatings)."""
+        return None
+
+    def rest_of_part(self, part: int, appraiser: str, seating: int) -> int:
+        """The rest of ``appraiser``'s seating of ``part`` (1, 2 ...), the ``seating``-th of the
+        session (a new one each time: its noise is its own)."""
+        parts = len(self.references)
+        if not 1 <= part <= parts:
+            raise StationError(f"the bench has parts 1 to {parts}, not part {part}.")
+        if appraiser not in self.appraisers:
+            raise StationError(
+                f"the bench knows appraisers {', '.join(self._names)}, not {appraiser!r}."
+            )
+        index = self._names.index(appraiser)
+        return 1 + (max(seating, 0) * len(self._names) + index) * parts + (part - 1)
+
+    def seated(self, rest: int) -> tuple[int, str]:
+        """The part and the appraiser of the ``rest``-th rest (1, 2 ...)."""
+        parts = len(self.references)
+        part, block = (rest - 1) % parts + 1, (rest - 1) // parts
+        return part, self._names[block % len(self._names)]
+
+    def rest_position(self, channel: str, rest: int, seed: int) -> float:
+        """The plate at rest 0, then the part as its appraiser seated and read it."""
+        if rest <= 0:
+            return 0.0
+        part, appraiser = self.seated(rest)
+        size = self.references[part - 1]
+        noise = random.Random(f"{seed}/grr-bench/{rest}").gauss(0.0, 1.0)
+        offset = self.appraisers[appraiser]
+        return size + offset + self.bias + self.slope * size + self.noise * noise

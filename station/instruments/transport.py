@@ -12,6 +12,7 @@ from __future__ import annotations
 import errno
 import os
 import re
+import stat
 import termios
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,6 +27,9 @@ NETWORK_SCHEMES = ("socket", "rfc2217")
 """URL schemes that reach a device over TCP: no local lock applies to them."""
 
 _BY_ID_FOLDER = Path("/dev/serial/by-id")
+
+PSEUDO_TERMINAL_MAJORS = range(136, 144)
+"""Linux's major device numbers of the pseudo-terminals a program opens (``/dev/pts/N``)."""
 
 
 @dataclass(frozen=True)
@@ -184,6 +188,28 @@ def own_terminal(path: str) -> bool:
         except OSError:
             continue
     return False
+
+
+def pseudo_terminal_opened(url: str) -> float | None:
+    """When the pseudo-terminal at ``url`` was opened (a POSIX time), or None when ``url`` is
+    no pseudo-terminal's own path: a serial adapter, a network URL, a path that does not
+    exist, or a link (a name someone chose, e.g. a bridge's ``link=``, which may point to a
+    new pseudo-terminal each time its program starts, and still be that program's line).
+
+    The kernel gives a closed pseudo-terminal's number to the next one opened: a
+    ``/dev/pts/N`` opened after a session last used that path is another program's."""
+    if url_scheme(url) is not None:
+        return None
+    try:
+        status = os.lstat(url)
+    except (OSError, ValueError):
+        return None
+    if not stat.S_ISCHR(status.st_mode):
+        return None
+    if os.major(status.st_rdev) not in PSEUDO_TERMINAL_MAJORS:
+        return None
+    # A device node's change time is its creation: reading and writing move only the others.
+    return status.st_ctime
 
 
 def refuse_own_terminal(url: str) -> None:

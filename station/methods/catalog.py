@@ -13,6 +13,7 @@ from functools import lru_cache
 from station.errors import StationError
 from station.extensions import METHODS, SiteExtensions, site_extensions
 from station.methods.contract import Method
+from station.methods.gage_rr import METHOD as GAGE_RR
 from station.methods.gain_schedule import METHOD as GAIN_SCHEDULE
 from station.methods.gauge_check import METHOD as GAUGE_CHECK
 from station.methods.gauge_linearity import METHOD as GAUGE_LINEARITY
@@ -29,6 +30,7 @@ BUILT_IN: tuple[Method, ...] = (
     LINEARITY,
     GAUGE_CHECK,
     GAUGE_LINEARITY,
+    GAGE_RR,
     JOINT_TROUBLESHOOTING,
     GAIN_SCHEDULE,
 )

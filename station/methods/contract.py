@@ -39,10 +39,10 @@ if TYPE_CHECKING:
 Layout = Literal["tidy", "wide"]
 """A CSV export's layout: a row per reading (tidy) or the table the method's analysis reads."""
 
-OPTIONS = ("reference", "tolerance", "process_variation", "order")
+OPTIONS = ("reference", "tolerance", "process_variation", "order", "pool_above")
 """The values a command line may give a method's batch analysis (``station analyze``): a
-reference size, a tolerance, a process variation (6σ), a fit's order. A method names the ones it
-takes in :attr:`Method.options`."""
+reference size, a tolerance, a process variation (6σ), a fit's order, the p above which a Gage
+R&R pools its interaction. A method names the ones it takes in :attr:`Method.options`."""
 
 
 # -- what a method is given and gives back -----------------------------------------------------
@@ -123,7 +123,9 @@ class LiveVerdict(Protocol):
     ) -> Mapping[str, Any]:
         """Take one accepted cycle (``times``: each reading's time; ``placement``: the
         repeated block's placement it was taken at, None outside one); per channel an update
-        whose ``alarms`` are new."""
+        whose ``alarms`` are new. A cycle of a ``parts`` step comes with the keyword ``part``
+        (the part it measured): the live analysis of a method whose procedures present parts
+        takes it."""
         ...
 
     def add_stroke(self, outcome: Any) -> None:
@@ -139,8 +141,9 @@ class LiveVerdict(Protocol):
         ...
 
     def rebuilt(self, cycles: Sequence[tuple[Any, ...]], session: Session | None) -> LiveVerdict:
-        """A fresh live analysis of ``cycles`` (values, number, times, placement) keeping what
-        is not a cycle (strokes), or taking that from ``session`` when given (resume)."""
+        """A fresh live analysis of ``cycles`` (values, number, times, placement, part)
+        keeping what is not a cycle (strokes), or taking that from ``session`` when given
+        (resume)."""
         ...
 
     def copy(self) -> LiveCopy:
@@ -280,6 +283,9 @@ class Method(ABC):
     """Whether its batch reads a CSV table by column name (linearity's stroke, s, h, v; a gains
     table's q) rather than each column as a channel: then no column is left out for counting
     the rows (``station analyze``), since 1, 2, 3 ... may be its own positions or joints."""
+    label_columns: ClassVar[tuple[str, ...]] = ()
+    """The columns of its CSV table that hold names, not numbers (a Gage R&R's part and
+    appraiser): ``station analyze`` keeps their cells as text (``ReadingTable.labels``)."""
     drift_chart: ClassVar[bool] = True
     """Whether its report draws the readings over time (cycles in time order; not strokes)."""
     files_in_register: ClassVar[bool] = False

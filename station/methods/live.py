@@ -1,16 +1,20 @@
 """The live analysis of cycles the engine feeds while a session runs (:class:`LiveCycles`:
-O(1) per cycle), the one most methods take; a method with another (linearity's strokes) keeps
-its own in its package."""
+O(1) per cycle), the one most methods take; the readings about their own group's mean
+(:class:`LiveAboutGroups`), which the gauge studies take; a method with another (linearity's
+strokes) keeps its own in its package."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Hashable, Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, Literal
+
+import numpy as np
 
 from station.analysis.live import LiveAnalysis, LiveReadings
 from station.analysis.monitor import LiveMonitor, Rejection
-from station.analysis.summary import Analysis, AnalysisConfig
+from station.analysis.summary import Analysis, AnalysisConfig, analyze
+from station.errors import StationError
 from station.session.alarms import live_events
 from station.session.model import Session
 
@@ -114,3 +118,104 @@ class CyclesSoFar:
     def result(self) -> None:
         """A kind of cycles has no result of its own."""
         return None
+
+
+GroupedRow = tuple[Mapping[str, float], int, Mapping[str, float] | None, Hashable]
+"""One accepted cycle: its values, number, reading times and the group it belongs to."""
+
+
+def about_groups(
+    rows: Sequence[GroupedRow], config: AnalysisConfig, channels: Sequence[str], what: str
+) -> Analysis:
+    """The analysis of each channel's readings less their group's mean (``what``: the group
+    in words, for the sentence when there is nothing yet)."""
+    if not rows:
+        raise StationError(f"no reading of a {what} yet: capture one first.")
+    groups = [row[3] for row in rows]
+    numbers = [row[1] for row in rows]
+    residuals: dict[str, np.ndarray] = {}
+    for channel in channels:
+        values = np.asarray([row[0].get(channel, np.nan) for row in rows], dtype=float)
+        if np.isnan(values).any():
+            continue
+        sums: dict[Hashable, list[float]] = {}
+        for group, value in zip(groups, values.tolist(), strict=True):
+            sums.setdefault(group, []).append(value)
+        means = {group: float(np.mean(found)) for group, found in sums.items()}
+        residuals[channel] = values - np.asarray([means[group] for group in groups])
+    if not residuals:
+        raise StationError(f"no channel was read at every {what} yet.")
+    return analyze(residuals, config, cycles=dict.fromkeys(residuals, numbers))
+
+
+class LiveAboutGroups:
+    """The live analysis of a gauge study: the readings about their own group's mean, which
+    is the gauge's variation without the differences the study makes on purpose (the masters of
+    a linearity study, a placement each; the parts of a Gage R&R). The readings themselves jump
+    from group to group by design, so a control chart of them would alarm at every new one;
+    about each group's mean they show what the capture can watch (a seating that went wrong, a
+    gauge that sticks). No live alarm is raised: the study's verdict is taken at the finish.
+
+    ``by``: what groups the cycles, the ``placement`` of a repeated block or the ``part`` a
+    parts step measured; ``what`` names one group in words."""
+
+    def __init__(
+        self,
+        config: AnalysisConfig,
+        channels: Sequence[str],
+        header: Mapping[str, Any],
+        *,
+        by: Literal["placement", "part"] = "placement",
+        what: str = "master",
+    ) -> None:
+        self.config, self.channels, self.header = config, tuple(channels), header
+        self.by, self.what = by, what
+        self.rows: list[GroupedRow] = []
+
+    def add_cycle(
+        self,
+        values: Mapping[str, float],
+        cycle: int,
+        times: Mapping[str, float] | None = None,
+        placement: int | None = None,
+        *,
+        part: int | None = None,
+    ) -> Mapping[str, Any]:
+        """Keep the cycle under its group; no live alarm (see the class)."""
+        group = placement if self.by == "placement" else part
+        self.rows.append((dict(values), cycle, times, -1 if group is None else group))
+        return {}
+
+    def add_stroke(self, outcome: Any) -> None:
+        """A gauge study streams no strokes."""
+        return None
+
+    def snapshot(self) -> Analysis:
+        """The readings about their groups' means so far."""
+        return about_groups(self.rows, self.config, self.channels, self.what)
+
+    def result(self) -> None:
+        """The study itself is judged at the finish."""
+        return None
+
+    def _empty(self) -> LiveAboutGroups:
+        return type(self)(self.config, self.channels, self.header, by=self.by, what=self.what)
+
+    def copy(self) -> LiveAboutGroups:
+        """The cycles so far (the analysis is computed when asked)."""
+        kept = self._empty()
+        kept.rows = list(self.rows)
+        return kept
+
+    def rebuilt(
+        self, cycles: Sequence[tuple[Any, ...]], session: Session | None
+    ) -> LiveAboutGroups:
+        """A fresh analysis of the accepted ``cycles`` (values, number, times, placement,
+        part)."""
+        fresh = self._empty()
+        for values, number, *rest in cycles:
+            times = rest[0] if rest else None
+            placement = rest[1] if len(rest) > 1 else None
+            part = rest[2] if len(rest) > 2 else None
+            fresh.add_cycle(values, number, times, placement, part=part)
+        return fresh

@@ -16,7 +16,7 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
     resolution = 0.0001             # the gauge's resolution in `unit`
     analysis = "repeatability"      # optional: the method that judges its sessions (see
                                     # station.methods: repeatability, relative_accuracy,
-                                    # linearity, gauge_check, gauge_linearity,
+                                    # linearity, gauge_check, gauge_linearity, gage_rr,
                                     # joint_troubleshooting, gain_schedule or a site's own);
                                     # default by the steps: a stroke step -> linearity, a repeat
                                     # block over x, y, z -> relative_accuracy, else repeatability
@@ -56,7 +56,7 @@ The file format (see ``procedures/repeatability.toml`` for a full example)::
 
     [[steps]]
     id = "fixture"
-    kind = "check"                  # check input zero capture cycles stroke repeat
+    kind = "check"                  # check input zero capture cycles parts stroke repeat
     title = "Fix the fixture"
     text = "Bolt or clamp the 3D fixture to a surface plate within the robot's work envelope."
 
@@ -70,6 +70,10 @@ Keys per step kind, beyond ``id``, ``kind``, ``title`` and ``text``:
 - ``capture``: ``channels`` (default: all the procedure's channels)
 - ``cycles``: ``channels``, ``min``, ``target`` (default: the procedure's cycle counts), ``prompt``
   (shown before each cycle; ``{cycle}`` and ``{count}`` are replaced by plain text substitution)
+- ``parts``: ``channels``, ``target`` (the parts, numbered 1 to target, each read once; also its
+  minimum), ``prompt`` (``{part}``: the part to read; ``{cycle}`` and ``{count}``: its place in
+  the order and how many). The order is drawn afresh each time the step comes (each placement
+  of a block) and recorded before its first reading; each reading records its part
 - ``stroke``: ``channels``, ``direction_channel`` (the channel that tracks the position along the
   stroke, e.g. the linear scale ``s``), ``min``, ``target`` (strokes), ``prompt``
 - ``repeat``: ``label`` (e.g. ``"placement"``), ``min``, ``target``, ``prompt``, and its own

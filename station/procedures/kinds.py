@@ -35,6 +35,9 @@ class StepSchema:
     """A block of inner ``steps`` repeated ``target`` times (no nesting)."""
     zero_window: bool = False
     """``readings``, ``settle`` and ``still``: a zero taken as the mean of several readings."""
+    parts: bool = False
+    """One reading of each of ``target`` numbered parts, in a random order drawn afresh each
+    time the step comes (a Gage R&R appraiser's trial)."""
 
     @property
     def allowed(self) -> tuple[str, ...]:
@@ -56,6 +59,7 @@ _STEP_SCHEMAS: dict[str, StepSchema] = {
     "zero": StepSchema(channels=True, zero_window=True),
     "capture": StepSchema(channels=True),
     "cycles": StepSchema(channels=True, counts=True),
+    "parts": StepSchema(channels=True, counts=True, parts=True),
     "stroke": StepSchema(channels=True, counts=True, direction=True),
     "repeat": StepSchema(block=True),
 }

@@ -13,6 +13,7 @@ from station.run.setup import (
     open_gauges,
     plan_steps,
     procedure_limits,
+    recorded_setup,
     resume_setup,
     setup_from_header,
 )
@@ -54,6 +55,7 @@ __all__ = [
     "open_gauges",
     "plan_steps",
     "procedure_limits",
+    "recorded_setup",
     "resume_setup",
     "set_problem",
     "setup_from_header",

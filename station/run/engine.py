@@ -11,7 +11,8 @@ method (:mod:`station.methods`). The engine itself holds no step-kind or method 
   listener hears of a reading after that, with the state and the live analysis that include it
   (:class:`~station.run.state.RunnerNotice`): a display never takes the engine's lock.
 * Cycles are numbered 1, 2, ... over the whole session; a rejected cycle keeps its number
-  (readings are never deleted), a resumed session continues the numbering.
+  (readings are never deleted), a resumed session continues the numbering. A reject names
+  its cycle (:meth:`Runner.reject`): cycles may arrive while the operator types the reason.
 * Alarms of the live analysis are written as ``alarm`` events (``live`` true, the rule named
   in words) when they first appear; an alarm is new unless it flags a cycle an alarm of the
   same rule and channel already flagged (a run growing by a point is one alarm). The live
@@ -306,6 +307,7 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
                         rejected=session.rejected.get(number),
                         resolution=self.setup.resolved_resolution,
                         times=cycle_times(list(cycle.readings), {"t": cycle.t}),
+                        part=cycle.part,
                     )
                 )
             self._next_cycle = session.next_cycle
@@ -376,19 +378,33 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
         """Stop the stream under way (its last points are written before it returns)."""
         self.stop_stream.set()
 
-    def reject_last(self, reason: str, by: str = "operator") -> int:
-        """Reject the most recent accepted cycle with ``reason`` (its readings stay in the file,
-        the analysis leaves it out); returns its number."""
+    def reject(self, cycle: int, reason: str, by: str = "operator") -> None:
+        """Reject cycle number ``cycle`` with ``reason`` (its readings stay in the file, the
+        analysis leaves it out). The cycle is named, never "the last one": a cycle that
+        arrives while the operator types the reason is not the one rejected. StationError,
+        with nothing written, for a cycle the session has not recorded or one already
+        rejected."""
         reason = reason.strip()
         if not reason:
-            raise StationError("give a reason for rejecting the cycle")
+            raise StationError(f"give a reason for rejecting cycle {cycle}")
         with self.lock:
             self.ensure_open()
-            accepted = [index for index, r in enumerate(self._cycles) if r.rejected is None]
-            if not accepted:
-                raise StationError("there is no recorded cycle to reject")
-            index = accepted[-1]
+            index = next(
+                (i for i in range(len(self._cycles) - 1, -1, -1) if self._cycles[i].cycle == cycle),
+                None,
+            )
+            if index is None:
+                recorded = (
+                    f"the last recorded is cycle {self._cycles[-1].cycle}"
+                    if self._cycles
+                    else "no cycle is recorded yet"
+                )
+                raise StationError(f"there is no cycle {cycle} to reject ({recorded})")
             record = self._cycles[index]
+            if record.rejected is not None:
+                raise StationError(
+                    f"cycle {cycle} is already rejected ({record.rejected}); nothing was written"
+                )
             self.append("reject", cycle=record.cycle, reason=reason, by=by, notify=False)
             # A new list: the states already taken keep the cycles as they were.
             self._cycles = list(self._cycles)
@@ -396,7 +412,6 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
             self._rebuild_live()
             self.say("info", f"Cycle {record.cycle} rejected: {reason}.")
             self._notify(self._last_event)  # the analysis without it follows
-            return record.cycle
 
     def note(self, text: str, by: str = "operator") -> None:
         """Record the operator's note."""
@@ -557,7 +572,7 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
             self._accepted_by_step[key] = self._accepted_by_step.get(key, 0) + 1
         self._accepted_count = len(accepted)
         self._live = self._live.rebuilt(
-            [(r.values, r.cycle, r.times, r.placement) for r in accepted], session
+            [(r.values, r.cycle, r.times, r.placement, r.part) for r in accepted], session
         )
         self._live_changed()
 
@@ -574,7 +589,7 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
         # alarms are on disk already: what the feeding raises again is not recorded twice.
         for record in self._cycles:
             if record.rejected is None:
-                self._live.add_cycle(record.values, record.cycle, record.times, record.placement)
+                self.feed_live(record)
         self._live_changed()
 
     def _zero_config(self) -> bool:

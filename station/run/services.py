@@ -53,6 +53,16 @@ class StepServices:
         """Accepted cycles recorded in a plan item."""
         return self._accepted_by_step.get(item.key, 0)
 
+    def accepted_parts(self, item: PlanItem) -> set[int]:
+        """The parts an accepted cycle of a plan item measured (a ``parts`` step's)."""
+        return {
+            record.part
+            for record in self._cycles
+            if record.rejected is None
+            and record.part is not None
+            and (record.step_id, record.placement) == item.key
+        }
+
     def claim(self) -> None:
         """Mark a capture, zero or stroke under way, and the step it belongs to: its result
         is recorded only while that step is still current."""
@@ -160,9 +170,12 @@ class StepServices:
         stale or duplicated, or in another unit than the session's."""
         return set_problem(result, needed, self.setup.resolved_unit)
 
-    def write_cycle(self, item: PlanItem, readings: Mapping[str, Any], by: str) -> CycleOutcome:
-        """Write a whole reading set as the next cycle of ``item``; the listener hears of it
-        as soon as it is on disk, the live analysis and its alarms follow."""
+    def write_cycle(
+        self, item: PlanItem, readings: Mapping[str, Any], by: str, *, part: int | None = None
+    ) -> CycleOutcome:
+        """Write a whole reading set as the next cycle of ``item`` (``part``: the part it is a
+        reading of, for a step that presents parts); the listener hears of it as soon as it is
+        on disk, the live analysis and its alarms follow."""
         number = self._next_cycle
         self.append(
             "reading",
@@ -170,6 +183,7 @@ class StepServices:
             cycle=number,
             step=item.step.id,
             placement=item.placement,
+            part=part,
             by=by,
             channels={
                 channel: {
@@ -192,6 +206,7 @@ class StepServices:
             placement=item.placement,
             resolution=self.setup.resolved_resolution,
             times=cycle_times(list(readings), self._last_event or {}),
+            part=part,
         )
         self._cycles.append(record)
         self._accepted_by_step[item.key] = self._accepted_by_step.get(item.key, 0) + 1
@@ -200,11 +215,17 @@ class StepServices:
         # state that includes it (the last-reading line); the alarms follow, and the live
         # analysis comes from the analysis thread (station.run.notices).
         self._notify(self._last_event)
-        self._record_alarms(
-            self._live.add_cycle(record.values, number, record.times, record.placement), number
-        )
+        self._record_alarms(self.feed_live(record), number)
         self._live_changed()
         return CycleOutcome(recorded=True, message=record.line(), cycle=record)
+
+    def feed_live(self, record: CycleRecord) -> Mapping[str, Any]:
+        """Give the live analysis one accepted cycle; its new alarms per channel. A cycle of a
+        part is given with its ``part`` (a method whose procedure presents parts takes it)."""
+        extra = {} if record.part is None else {"part": record.part}
+        return self._live.add_cycle(
+            record.values, record.cycle, record.times, record.placement, **extra
+        )
 
     def stroke_recorded(self, outcome: StrokeOutcome) -> None:
         """A whole stroke is on disk: the live analysis takes it and the listener hears."""

@@ -6,8 +6,9 @@ from __future__ import annotations
 
 import math
 import socket
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -17,13 +18,14 @@ from station.instruments.base import SerialSettings
 from station.instruments.gauge import GaugeSet, PortSpec
 from station.instruments.protocols import get_protocol
 from station.instruments.reader import DEFAULT_BACKOFF
+from station.instruments.transport import pseudo_terminal_opened
 from station.instruments.triggers import TRIGGERS, Trigger
 from station.methods import method_of
 from station.procedures import Procedure, Step, discover_procedures
 from station.run.steps import handler_for
 from station.run.steps.base import PlanItem
 from station.session.header import header_limits
-from station.session.model import load_session
+from station.session.model import Session, load_session
 
 
 @dataclass(frozen=True)
@@ -264,18 +266,102 @@ def setup_from_header(
     )
 
 
-def resume_setup(
+def recorded_setup(
     path: str | Path,
     *,
     procedures_dirs: Sequence[str | Path] = (),
     ports: Sequence[PortSetup] | None = None,
 ) -> SessionSetup:
-    """The set-up of the session in ``path`` (its procedure found by id), to resume it."""
+    """The set-up the unfinished session in ``path`` records (its procedure found by id;
+    ``ports`` replaces its line), not checked against the devices as they are now: to compare
+    what a command line gives with the session's. To resume, take :func:`resume_setup`."""
+    return _recorded(path, procedures_dirs, ports)[0]
+
+
+def resume_setup(
+    path: str | Path,
+    *,
+    procedures_dirs: Sequence[str | Path] = (),
+    ports: Sequence[PortSetup] | None = None,
+    own_simulators: Collection[str] = (),
+) -> SessionSetup:
+    """The set-up to resume the session in ``path`` with (its procedure found by id; ``ports``
+    replaces the recorded line: a USB adapter that came back under another name).
+
+    A port at a pseudo-terminal path the session used (``/dev/pts/5``) that was opened after
+    the session last used it is refused (StationError naming the port field): the kernel gives
+    a closed pseudo-terminal's number to the next program, and opened as the gauges' line it
+    would be someone's terminal or another program's. ``own_simulators``: the URLs of
+    simulators this process started to stand in for the instruments (the demo's), which are
+    the line whatever their number."""
+    setup, session = _recorded(path, procedures_dirs, ports)
+    for port in setup.ports:
+        if port.url not in own_simulators:
+            _refuse_another_pseudo_terminal(port.url, _last_used(session))
+    return setup
+
+
+def _recorded(
+    path: str | Path,
+    procedures_dirs: Sequence[str | Path],
+    ports: Sequence[PortSetup] | None,
+) -> tuple[SessionSetup, Session]:
     session = load_session(path, recover=False)
     if session.finished:
         raise StationError(f"session {path} is finished; start a new session instead")
     procedure = discover_procedures(procedures_dirs).get(session.procedure_id)
-    return setup_from_header(session.header, procedure, ports=ports)
+    return setup_from_header(session.header, procedure, ports=ports), session
+
+
+def _last_used(session: Session) -> dict[str, str]:
+    """When the session last wrote while each of its lines was in use, by URL (an event's
+    ``t``): the header's ports from its creation, a resume's ports from that resume on."""
+
+    def urls(instruments: Any) -> list[str]:
+        ports = dict(instruments or {}).get("ports") or ()
+        return [str(port.get("url")) for port in ports if isinstance(port, Mapping)]
+
+    in_use = urls(session.header.get("instruments"))
+    last = {url: str(session.header.get("created") or "") for url in in_use}
+    for event in session.events:
+        if event.get("type") == "resume" and event.get("instruments"):
+            in_use = urls(event["instruments"])
+        for url in in_use:
+            last[url] = str(event.get("t") or "")
+    return last
+
+
+def _refuse_another_pseudo_terminal(url: str, last_used: Mapping[str, str]) -> None:
+    """StationError when ``url`` is a pseudo-terminal opened after the session last used it."""
+    used_at = _moment(last_used.get(url))
+    opened = pseudo_terminal_opened(url)
+    if used_at is None or opened is None:
+        return
+    opened_at = datetime.fromtimestamp(opened, UTC)
+    if opened_at <= used_at:
+        return
+    raise StationError(
+        f"{url} is not the pseudo-terminal this session recorded: the session last used "
+        f"{url} at {_local(used_at)}, and the one there now was opened at {_local(opened_at)}, "
+        "by another program (the number of a closed pseudo-terminal is given to the next "
+        "one); name the port of the running simulator or bridge. Nothing was written",
+        field="port",
+    )
+
+
+def _moment(text: str | None) -> datetime | None:
+    try:
+        return datetime.fromisoformat(text) if text else None
+    except ValueError:
+        return None
+
+
+def _local(moment: datetime) -> str:
+    """A time as the operator's clock shows it, to the second (with the date when not today)."""
+    local = moment.astimezone()
+    if local.date() == datetime.now().astimezone().date():
+        return f"{local:%H:%M:%S}"
+    return f"{local:%Y-%m-%d %H:%M:%S}"
 
 
 def open_gauges(

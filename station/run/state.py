@@ -53,6 +53,9 @@ class Action:
     paced_by_devices: bool = False
     """For ``capture``: the sets come by themselves (the robot's arrival, a DATA press), so a
     front end says so instead of asking for a key per cycle."""
+    part: int | None = None
+    """For ``capture`` in a step that presents numbered parts (a ``parts`` step): the part the
+    next reading set is of, else None."""
 
     def __post_init__(self) -> None:
         if self.kind not in ACTION_KINDS:
@@ -142,14 +145,17 @@ class CycleRecord:
     """The session's gauge resolution: :meth:`line` shows that many decimals."""
     times: Mapping[str, float] | None = None
     """Each channel's reading time (``t_wall``), for the drift's trend; None when unknown."""
+    part: int | None = None
+    """The part a ``parts`` step measured in this cycle, else None."""
 
     def line(self, *, figures: bool = False) -> str:
         """The one-line form ``cycle 7 x=+0.0012 y=-0.0003 z=+0.0001`` (values at the
-        resolution's decimals, as the gauge shows them); ``figures=True`` writes them at the
-        figures' decimals instead (``x=+0.00120``), for a screen that shows statistics beside
-        them in that one format."""
+        resolution's decimals, as the gauge shows them; ``cycle 7 part 3 x=...`` for a part);
+        ``figures=True`` writes them at the figures' decimals instead (``x=+0.00120``), for a
+        screen that shows statistics beside them in that one format."""
         write = format_figure if figures else format_value
-        return f"cycle {self.cycle} " + " ".join(
+        part = "" if self.part is None else f"part {self.part} "
+        return f"cycle {self.cycle} {part}" + " ".join(
             f"{channel}={write(value, self.resolution)}" for channel, value in self.values.items()
         )
 

@@ -71,6 +71,8 @@ class Cycle:
     readings: Mapping[str, ChannelReading]
     placement: int | None = None
     """The repeat-block iteration (fixture placement) the cycle belongs to, when any."""
+    part: int | None = None
+    """The part a ``parts`` step measured in this cycle (1, 2 ...), when any."""
 
 
 @dataclass(frozen=True)
@@ -220,6 +222,7 @@ class Replay:
                 step=str(record.get("step", "")),
                 readings=readings,
                 placement=placement if isinstance(placement, int) else None,
+                part=record.get("part"),
             )
         elif kind == "reject":
             self.rejected[record["cycle"]] = record["reason"]
@@ -352,6 +355,11 @@ def _check_reading(replay: Replay, record: Mapping[str, Any]) -> None:
     cycle = _need_cycle(record)
     if cycle in replay.cycles:
         raise ValueError(f"cycle {cycle} is recorded twice (seq {replay.cycles[cycle].seq})")
+    part = record.get("part")
+    if part is not None and not (
+        isinstance(part, int) and not isinstance(part, bool) and 1 <= part <= COUNT_LIMIT
+    ):
+        raise ValueError(f"a reading's 'part' must be a whole number from 1 to {COUNT_LIMIT}")
     channels = record.get("channels")
     if not isinstance(channels, dict) or not channels:
         raise ValueError("a reading event needs a table 'channels'")

@@ -7,7 +7,9 @@ column per channel, rejected rows left out. Lines whose first non-blank characte
 comments (where the data came from, the unit) and blank lines are skipped. Columns named
 ``cycle``, ``subgroup`` or ``t`` (any case) number or time the rows, and so do ``sample``,
 ``id``, ``index`` and ``obs`` (the row numbers Minitab, JASP and Excel export): they are not
-channels. :func:`row_counters` finds a column of another name that only counts the rows.
+channels. :func:`row_counters` finds a column of another name that only counts the rows. A
+caller may name *label* columns (a Gage R&R's part and appraiser): their cells are kept as text,
+not read as channels.
 
 Every problem is a :class:`~station.errors.StationError` that names the file, and where it
 helps the line (1-based, counted in the file as an editor shows it) and the column.
@@ -18,7 +20,8 @@ from __future__ import annotations
 import csv
 import re
 import warnings
-from dataclasses import dataclass
+from collections.abc import Collection
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -65,6 +68,9 @@ class ReadingTable:
     placements: np.ndarray | None = None
     """A tidy table's fixture placement of each accepted cycle (aligned with the channels),
     None when it records none."""
+    labels: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    """The label columns the caller named that the table has (by their name in the file):
+    each row's cell as text, stripped."""
 
     @property
     def rows(self) -> int:
@@ -111,16 +117,18 @@ def _parse_cell(text: str, path: Path, line: int, column: str) -> float:
     )
 
 
-def read_table(path: str | Path) -> ReadingTable:
+def read_table(path: str | Path, labels: Collection[str] = ()) -> ReadingTable:
     """Read a CSV table of readings: a header row, ``#`` comments, one column per channel.
+    The columns named in ``labels`` (compared case-insensitively; a Gage R&R's part and
+    appraiser) hold names: their cells are kept as text in :attr:`ReadingTable.labels`.
 
     The rows are parsed by numpy in one streaming pass (``numpy.loadtxt``, no per-cell Python);
     a file it cannot take is read again line by line to name the first fault. Raises
     StationError for a missing or unreadable file, a FIFO, a device or a folder, an empty file,
     a first row of numbers (no header), a header without channel columns, duplicate column
     names, a row with a different number of cells than the header (naming the line), a cell
-    that is not a finite number in ASCII digits within ±1e150 (naming line and column), and a
-    ``cycle`` that is not a whole number from 1 to 2**53.
+    that is not a finite number in ASCII digits within ±1e150 (naming line and column), an
+    empty label cell, and a ``cycle`` that is not a whole number from 1 to 2**53.
     """
     path = Path(path)
     info = check_regular_file(path, "CSV file of readings")
@@ -142,22 +150,17 @@ def read_table(path: str | Path) -> ReadingTable:
                         f"{plain(path)} has a header but no readings; add one row per cycle."
                     )
                 return _read_tidy(path, names, data_rows, tuple(comments))
-            channel_positions = _check_header(names, header_line, path)
-            start = handle.tell()
-            try:
-                data = _load_rows(handle, len(names))
-            except ValueError:
-                data = None
-            if data is None:
-                handle.seek(start)
-                try:
-                    data = _load_rows((ln for ln in handle if ln.strip()), len(names))
-                except ValueError:
-                    data = None
-            if data is None:
-                handle.seek(start)
-                _diagnose(handle, path, header_line, names)
-                raise StationError(f"{plain(path)}: the rows cannot be read as numbers.")
+            wanted = {name.lower() for name in labels}
+            label_positions = [i for i, name in enumerate(names) if name.lower() in wanted]
+            channel_positions = _check_header(names, header_line, path, label_positions)
+            label_cells: dict[str, tuple[str, ...]] = {}
+            if label_positions:
+                # Text beside the numbers: read row by row (a study's table is small).
+                data, label_cells = _read_labelled(
+                    handle, path, header_line, names, label_positions
+                )
+            else:
+                data = _read_numbers(handle, path, header_line, names)
     except UnicodeDecodeError:
         raise StationError(
             f"{plain(path)} is not a text file (not UTF-8); give a CSV file of readings."
@@ -171,16 +174,19 @@ def read_table(path: str | Path) -> ReadingTable:
     if bad.any():
         # Rare: numpy took an 'inf', 'nan' or a huge value. Name the line and the cell.
         with open(path, encoding="utf-8-sig", newline="") as handle:
-            _diagnose(handle, path, 0, names, skip_header=True)
+            _diagnose(handle, path, 0, names, skip_header=True, labels=label_positions)
         raise StationError(f"{plain(path)}: a cell is not a finite number.")
-    cycle_position = next((i for i, name in enumerate(names) if name.lower() == "cycle"), None)
+    # The numeric columns, in the order of ``data``'s (the label columns are kept apart).
+    numeric = [name for i, name in enumerate(names) if i not in label_positions]
+    channel_positions = [numeric.index(names[i]) for i in channel_positions]
+    cycle_position = next((i for i, name in enumerate(numeric) if name.lower() == "cycle"), None)
     cycles = None
     if cycle_position is not None:
         numbers = data[:, cycle_position]
         wrong = (numbers != np.floor(numbers)) | (numbers < 1) | (numbers > CYCLE_LIMIT)
         if wrong.any():
             with open(path, encoding="utf-8-sig", newline="") as handle:
-                _diagnose(handle, path, 0, names, skip_header=True)
+                _diagnose(handle, path, 0, names, skip_header=True, labels=label_positions)
             raise StationError(f"{plain(path)}: a cycle number is not 1, 2, 3 ...")
         cycles = numbers.astype(np.int64)
     if info.st_size <= EXPORT_COMMENT_SCAN_LIMIT:
@@ -190,16 +196,68 @@ def read_table(path: str | Path) -> ReadingTable:
             ]
     return ReadingTable(
         path=path,
-        channels={names[i]: np.ascontiguousarray(data[:, i]) for i in channel_positions},
+        channels={numeric[i]: np.ascontiguousarray(data[:, i]) for i in channel_positions},
         index_columns=tuple(name for name in names if name.lower() in INDEX_COLUMNS),
         comments=tuple(comments),
         cycles=cycles,
         excluded_cycles=excluded_in_comments(comments),
         times=next(
-            (np.ascontiguousarray(data[:, i]) for i, n in enumerate(names) if n.lower() == "t"),
+            (np.ascontiguousarray(data[:, i]) for i, n in enumerate(numeric) if n.lower() == "t"),
             None,
         ),
+        labels=label_cells,
     )
+
+
+def _read_numbers(handle: Any, path: Path, header_line: int, names: list[str]) -> np.ndarray:
+    """The data rows of a table of numbers, in one streaming pass where numpy can take them;
+    else the first fault, named."""
+    start = handle.tell()
+    try:
+        return _load_rows(handle, len(names))
+    except ValueError:
+        pass
+    handle.seek(start)
+    try:
+        return _load_rows((ln for ln in handle if ln.strip()), len(names))
+    except ValueError:
+        pass
+    handle.seek(start)
+    _diagnose(handle, path, header_line, names)
+    raise StationError(f"{plain(path)}: the rows cannot be read as numbers.")
+
+
+def _read_labelled(
+    handle: Any, path: Path, header_line: int, names: list[str], label_positions: list[int]
+) -> tuple[np.ndarray, dict[str, tuple[str, ...]]]:
+    """The data rows of a table with label columns: the numbers of the other columns (one row
+    each) and each label column's cells as text; a fault names its line and column."""
+    rows: list[list[float]] = []
+    labels: dict[int, list[str]] = {i: [] for i in label_positions}
+    for line_number, line in enumerate(handle, start=header_line + 1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        cells = _cells(line, path, line_number)
+        if len(cells) != len(names):
+            raise StationError(
+                f"{plain(path)}: line {line_number} has {len(cells)} cells but the header has "
+                f"{len(names)} columns; every row needs one cell per column."
+            )
+        row = []
+        for index, (name, cell) in enumerate(zip(names, cells, strict=True)):
+            if index in labels:
+                if not cell.strip():
+                    raise StationError(
+                        f"{plain(path)}: line {line_number}, column {plain(name, limit=40)!r}: "
+                        "the cell is empty; name it or delete the row."
+                    )
+                labels[index].append(cell.strip())
+            else:
+                row.append(_parse_cell(cell, path, line_number, name))
+        rows.append(row)
+    width = len(names) - len(label_positions)
+    data = np.asarray(rows, dtype=np.float64).reshape(len(rows), width)
+    return data, {names[i]: tuple(cells) for i, cells in labels.items()}
 
 
 _REJECTED_COMMENT = re.compile(r"^rejected cycle (\d+)\b")
@@ -334,7 +392,9 @@ def _read_header(handle: Any, path: Path) -> tuple[list[str], int, list[str]]:
         return comments, line_number, [cell.strip() for cell in cells]
 
 
-def _check_header(names: list[str], header_line: int, path: Path) -> list[int]:
+def _check_header(
+    names: list[str], header_line: int, path: Path, label_positions: Collection[int] = ()
+) -> list[int]:
     where = f"{plain(path)}: line {header_line}"
     if all(_is_number_text(name) or _NAMED_NUMBER.match(name) for name in names):
         raise StationError(
@@ -351,7 +411,11 @@ def _check_header(names: list[str], header_line: int, path: Path) -> list[int]:
             f"{where}: column {plain(duplicates[0], limit=40)!r} appears twice in the header; "
             "give every column its own name."
         )
-    channel_positions = [i for i, name in enumerate(names) if name.lower() not in INDEX_COLUMNS]
+    channel_positions = [
+        i
+        for i, name in enumerate(names)
+        if name.lower() not in INDEX_COLUMNS and i not in label_positions
+    ]
     if not channel_positions:
         raise StationError(
             f"{where}: no channel columns in the header {plain(','.join(names), limit=80)!r}; "
@@ -361,9 +425,16 @@ def _check_header(names: list[str], header_line: int, path: Path) -> list[int]:
 
 
 def _diagnose(
-    handle: Any, path: Path, first_line: int, names: list[str], *, skip_header: bool = False
+    handle: Any,
+    path: Path,
+    first_line: int,
+    names: list[str],
+    *,
+    skip_header: bool = False,
+    labels: Collection[int] = (),
 ) -> None:
-    """Read the rows line by line (streaming, nothing kept) and raise at the first fault."""
+    """Read the rows line by line (streaming, nothing kept) and raise at the first fault
+    (``labels``: the positions of label columns, which hold text)."""
     line_number = first_line
     header_seen = not skip_header
     for line in handle:
@@ -381,6 +452,8 @@ def _diagnose(
                 f"{len(names)} columns; every row needs one cell per column."
             )
         for index, name in enumerate(names):
+            if index in labels:
+                continue
             value = _parse_cell(cells[index], path, line_number, name)
             if name.lower() == "cycle" and (
                 value != int(value) or value < 1 or value > CYCLE_LIMIT

@@ -329,10 +329,13 @@ class StationApp(App[int]):
             count=demo.count,
         )
 
-    def _find_demo_fixture(self, setup: SessionSetup) -> None:
+    def _simulator_at(self, url: str) -> Any:
+        """The simulated set-up this process runs on ``url`` (the demo's), or None."""
         lab = self.config.demo_lab
-        urls = [port.url for port in setup.ports]
-        found = [lab.by_url(url) if lab is not None else running_fixture(url) for url in urls]
+        return lab.by_url(url) if lab is not None else running_fixture(url)
+
+    def _find_demo_fixture(self, setup: SessionSetup) -> None:
+        found = [self._simulator_at(port.url) for port in setup.ports]
         self.demo_fixture = next((f for f in found if f is not None), None)
 
     def start_session(self, setup: SessionSetup) -> None:
@@ -391,7 +394,11 @@ class StationApp(App[int]):
         continue an unfinished session file."""
         from station.run import Runner, resume_setup  # deferred: the engine loads numpy
 
-        setup = resume_setup(path, procedures_dirs=self.config.procedure_dirs, ports=ports)
+        # The demo's own simulators are its line, whatever pseudo-terminal number they got.
+        own = [port.url for port in ports or () if self._simulator_at(port.url) is not None]
+        setup = resume_setup(
+            path, procedures_dirs=self.config.procedure_dirs, ports=ports, own_simulators=own
+        )
         self.warm_up_analysis()
         self._find_demo_fixture(setup)
         self._open_instruments(setup)

@@ -54,14 +54,23 @@ class DemoFixture:
         brought it (a moving robot follows its own clock): for two fixtures, home at the
         placement's first fixture until its return is to be captured; for one fixture, the
         taught position (rest 0) for the zero, then a new return for every cycle; on the bar,
-        still at its end for the zeros, shuttling for the strokes. However many
+        still at its end for the zeros, shuttling for the strokes; on a Gage R&R bench, the part
+        the step asks for as its appraiser seats it. However many
         sets the station reads at one of these rests, they all read that rest."""
         simulator = self.simulator
         if simulator.motion is not None:
             return
         model = simulator.model
         capturing = state.action.kind == "capture"
-        if model.moves_per_set:
+        part = getattr(state.action, "part", None)
+        if hasattr(model, "rest_of_part"):
+            # A Gage R&R bench: the plate, or the part asked for as its appraiser (the step)
+            # seats it, a new seating per cycle.
+            if not capturing or part is None or state.current is None:
+                rest = 0
+            else:
+                rest = model.rest_of_part(part, state.current.step.id, state.next_cycle)
+        elif model.moves_per_set:
             # The bar's robot stands at its end for the zeros and shuttles for the strokes.
             rest = 1 if state.action.kind == "stream" else 0
         elif hasattr(model, "rest_of"):

@@ -137,6 +137,21 @@ def test_hang_up_during_capture_leaves_a_resumable_session(tmp_path: Path) -> No
     finally:
         second.close()
 
+    # The next demo resumes it on its own simulator (issue 26, item 4): the recorded
+    # pseudo-terminal went with the demo that hung up. The robot's returns are cycles again.
+    third = Pane(_station("demo", "--sessions", str(tmp_path)), tmp_path)
+    try:
+        third.wait_for("Resume:", timeout=30)
+        third._tmux("send-keys", "-t", third.name, "r")
+        third.wait_for("resumes on its own running simulator", timeout=30)
+        third._tmux("send-keys", "-t", third.name, "F2")
+        deadline = time.monotonic() + 30
+        while max(load_session(sessions[0], recover=False).cycles) == max(session.cycles):
+            assert time.monotonic() < deadline, f"no cycle after the resume:\n{third.screen()}"
+            time.sleep(0.2)
+    finally:
+        third.close()
+
 
 @pytest.mark.parametrize(
     ("procedure", "channels", "report", "minimum"),
@@ -214,5 +229,31 @@ def test_demo_autopilot_walks_the_gauge_linearity_study(tmp_path: Path) -> None:
         assert [b["reference"] for b in study["biases"]] == [0.1, 0.3, 0.5, 0.7, 0.9]
         register = json.loads((tmp_path / "demo" / "gauges.json").read_text())
         assert "gauge_linearity" in register["gauges"]["DEMO-IND-1"]["studies"]
+    finally:
+        pane.close()
+
+
+def test_demo_autopilot_walks_the_gage_rr_study(tmp_path: Path) -> None:
+    """``station demo --procedure gage_rr --autopilot --count 2``: three appraisers' names
+    copied from the simulated bench, each appraiser's ten parts seated in the order the station
+    drew (one reading rejected and its part read again), two trials, and the study's own
+    verdict on the summary, filed in the demo folder's own gauge register."""
+    command = ["demo", "--procedure", "gage_rr", "--count", "2", "--autopilot", "--pace", "0.05"]
+    pane = Pane(_station(*command, "--sessions", str(tmp_path)), tmp_path)
+    try:
+        pane.wait_for("Verdict:", timeout=300)
+        time.sleep(0.5)  # the summary paints in a few frames
+        screen = pane.wait_for("Export report", timeout=10)
+        assert re.search(r"Verdict: (CONDITIONALLY )?ACCEPTABLE|Verdict: NOT ACCEPTABLE", screen)
+        assert "3 appraisers x 10 parts" in screen, screen
+        (session,) = (tmp_path / "demo").glob("*.jsonl")
+        analysed = subprocess.run(
+            _station("analyze", str(session), "--json"), capture_output=True, text=True, cwd=ROOT
+        )
+        study = json.loads(analysed.stdout)["gage_rr"]
+        assert study["trials"] == 2 and study["n"] == 60
+        assert study["appraiser_names"] == {"A": "Ann", "B": "Bo", "C": "Cy"}
+        register = json.loads((tmp_path / "demo" / "gauges.json").read_text())
+        assert "gage_rr" in register["gauges"]["DEMO-IND-1"]["studies"]
     finally:
         pane.close()

@@ -38,6 +38,7 @@ PROCEDURES = (
     "relative_accuracy",
     "gauge_check",
     "gauge_linearity",
+    "gage_rr",
     "joint_troubleshooting",
     "gain_schedule",
 )

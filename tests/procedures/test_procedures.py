@@ -346,6 +346,7 @@ def test_the_analysis_kind_defaults_by_step_kinds(tmp_path: Path) -> None:
         "linearity": "linearity",
         "gauge_check": "gauge_check",
         "gauge_linearity": "gauge_linearity",
+        "gage_rr": "gage_rr",
         "joint_troubleshooting": "joint_troubleshooting",
         "gain_schedule": "gain_schedule",
     }
@@ -358,6 +359,9 @@ def test_a_declared_analysis_kind_is_kept_and_validated(tmp_path: Path) -> None:
         ("accuracy", CHECK, "'analysis' must be one of repeatability, relative_accuracy, "),
         ("linearity", CHECK, "'analysis' linearity needs a stroke step"),
         ("relative_accuracy", CHECK, "'analysis' relative_accuracy needs a repeat block"),
+        # A parts step outside a block is no trial: the study needs one per appraiser in it.
+        ("gage_rr", REPEAT, r"'analysis' gage_rr needs a repeat block \(one per trial\) holding"),
+        ("gage_rr", CHECK.replace('kind = "check"', 'kind = "parts"'), "needs a repeat block"),
     ):
         text = HEAD.replace('unit = "in"', f'unit = "in"\nanalysis = "{kind}"') + body
         with pytest.raises(StationError, match=fault):

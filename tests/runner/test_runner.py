@@ -99,7 +99,7 @@ def test_repeatability_walk_poll(simulator, gauges_for, tmp_path):
         assert outcome.recorded, outcome.message
         outcomes.append(outcome)
         if outcome.cycle.cycle == 12:
-            assert runner.reject_last("the cube slipped on the end effector") == 12
+            runner.reject(12, "the cube slipped on the end effector")
             runner.note("re-seated the cube")
             runner.pause()
             assert runner.state().status == "paused" and not runner.state().can_capture
@@ -290,7 +290,7 @@ def test_push_trigger_records_sets_without_capture_calls(gauges_for, tmp_path):
         assert refused.wait(30), "the sixth set was neither refused nor recorded"
         assert cycles_seen == [1, 2, 3, 4, 5]
         # capture() under push waits for the device's next set and returns its outcome.
-        runner.reject_last("pressed DATA twice")
+        runner.reject(5, "pressed DATA twice")
         waiter: list = []
         thread = threading.Thread(target=lambda: waiter.append(runner.capture(30.0)))
         thread.start()
@@ -306,6 +306,49 @@ def test_push_trigger_records_sets_without_capture_calls(gauges_for, tmp_path):
         assert len(values["x"]) == 5
     finally:
         sim.stop()
+
+
+def test_a_reject_rejects_the_cycle_it_names_not_the_last(simulator, gauges_for, tmp_path):
+    # Issue 26, item 1: the operator names cycle 2 (the dialog's title); cycle 3 arrives
+    # while the reason is typed; confirming rejects cycle 2, and cycle 3 stays.
+    setup = setup_for(simulator.url, cycles_only_procedure(tmp_path), cycles=5)
+    runner = Runner.start(setup, gauges_for(setup), tmp_path)
+    for _ in range(2):
+        assert runner.capture(3.0).recorded
+    named = runner.state().last_cycle.cycle
+    assert named == 2
+    assert runner.capture(3.0).recorded  # arrives between naming and confirming
+    runner.reject(named, "the cube slipped")
+    state = runner.state()
+    assert [(c.cycle, c.rejected) for c in state.cycles] == [
+        (1, None),
+        (2, "the cube slipped"),
+        (3, None),
+    ]
+    assert state.accepted == 2
+    # A cycle that does not exist, or one already rejected, is refused with nothing written.
+    size = runner.path.stat().st_size
+    with pytest.raises(
+        StationError, match=r"no cycle 9 to reject \(the last recorded is cycle 3\)"
+    ):
+        runner.reject(9, "typo")
+    with pytest.raises(StationError, match=r"cycle 2 is already rejected \(the cube slipped\)"):
+        runner.reject(2, "again")
+    with pytest.raises(StationError, match="reason"):
+        runner.reject(3, "  ")
+    assert runner.path.stat().st_size == size
+    runner.interrupt("test over")
+    session = load_session(runner.path, recover=False)
+    assert session.rejected == {2: "the cube slipped"}
+    assert to_json(runner.analysis()) == to_json(batch_analysis(runner.path))
+
+
+def test_a_reject_before_any_cycle_is_refused(simulator, gauges_for, tmp_path):
+    setup = setup_for(simulator.url, cycles_only_procedure(tmp_path), cycles=5)
+    runner = Runner.start(setup, gauges_for(setup), tmp_path)
+    with pytest.raises(StationError, match=r"no cycle 1 to reject \(no cycle is recorded yet\)"):
+        runner.reject(1, "bumped")
+    runner.interrupt("test over")
 
 
 def test_runner_imports_no_ui():

@@ -54,7 +54,7 @@ def test_engine_alarms_are_phase_two_and_a_replay_gives_them_exactly(
     assert runner.header["freeze_after"] == procedure.cycles_min == 25
     capture(runner, 28)
     # A cycle rejected after the limits froze: they stay frozen, raised alarms stay raised.
-    runner.reject_last("the cube slipped")
+    runner.reject(28, "the cube slipped")
     capture(runner, 4)
     before = runner.state().alarm_list
     runner.interrupt("test: link dropped")

@@ -181,7 +181,7 @@ def test_the_prompt_names_the_cycle_the_record_will_after_a_rejected_one(tmp_pat
         for _ in range(4):
             assert runner.capture(3.0).recorded
         assert runner.prompt() == "Cycle 5 of 30."
-        assert runner.reject_last("the cube slipped") == 4
+        runner.reject(4, "the cube slipped")
         state = runner.state()
         assert state.action.prompt == "Cycle 5 (4 of 30 accepted)."
         from station.tui.screens.dashboard import DashboardView

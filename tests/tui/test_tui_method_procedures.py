@@ -53,11 +53,12 @@ def text_of(app: StationApp, selector: str) -> str:
 
 
 async def run_procedure(
-    pilot, tui, procedure: str, url: str, channel_map: str, count: str | None, values
+    pilot, tui, procedure: str, url: str, channel_map: str, count: str | None, values, seen=None
 ) -> None:
     """Set up ``procedure`` on ``url`` and walk it by keyboard to the summary: Enter on
     checks and zeros, the fields typed (``values(placement)``) at inputs, Space at captures,
-    ``f`` once every step is done."""
+    ``f`` once every step is done. ``seen(app, state)`` looks at the screen before each
+    capture."""
     app = pilot.app
     await pilot.pause()
     app.screen.open_new(procedure)
@@ -81,6 +82,9 @@ async def run_procedure(
         if kind == "capture":
             await tui.wait_until(pilot, lambda: isinstance(app.screen, DashboardScreen))
             if state.progress.done < state.progress.target:
+                if seen is not None:
+                    await pilot.pause()
+                    seen(app, app.runner.state())
                 await tui.capture_one(pilot)
                 continue
             # Every cycle of the step is in: Go on (the next joint, or the finish).

@@ -117,9 +117,10 @@ def _channel_map(args: argparse.Namespace, channels: tuple[str, ...]) -> dict[st
 
 
 def resumed_setup(args: argparse.Namespace) -> Any:
-    from station.run import PortSetup, resume_setup
+    from station.run import PortSetup, recorded_setup, resume_setup
 
-    setup = resume_setup(args.resume, procedures_dirs=args.procedures)
+    # As recorded, for the comparison: the line is checked once it is the one to open.
+    setup = recorded_setup(args.resume, procedures_dirs=args.procedures)
     conflicts = _resume_conflicts(args, setup)
     if conflicts:
         raise StationError(
@@ -127,7 +128,7 @@ def resumed_setup(args: argparse.Namespace) -> Any:
             "header records; leave them out, or start a new session"
         )
     if not args.port:
-        return setup
+        return resume_setup(args.resume, procedures_dirs=args.procedures)
     recorded = setup.ports[0] if setup.ports else None
     protocol = args.protocol or (recorded.protocol if recorded else None)
     if not protocol:

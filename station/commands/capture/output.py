@@ -65,9 +65,17 @@ class Printer:
             # The runner's own cycle line: values at the gauges' decimals, as they show them.
             values = {ch: spec["value"] for ch, spec in event["channels"].items()}
             record = CycleRecord(
-                event["cycle"], values, event["step"], None, resolution=self.resolution
+                event["cycle"],
+                values,
+                event["step"],
+                None,
+                resolution=self.resolution,
+                part=event.get("part"),
             )
             self._print(record.line())
+        elif kind == "note" and event.get("by") == "station":
+            # What the station decided for the operator (the order of a step's parts).
+            self._print(f"note: {event['text']}")
         elif kind == "step":
             self._print(f"step {event['step']}: done (by {event.get('by', 'operator')})")
         elif kind == "zero":

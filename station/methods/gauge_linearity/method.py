@@ -29,7 +29,7 @@ from station.methods.contract import (
     MethodVerdict,
     PlacementWords,
 )
-from station.methods.gauge_linearity.live import LiveAboutMasters
+from station.methods.gauge_linearity.live import live_about_masters
 from station.methods.gauge_linearity.study import (
     ALPHA,
     BIAS_SHARE,
@@ -37,6 +37,7 @@ from station.methods.gauge_linearity.study import (
     LinearityStudy,
     linearity_study,
 )
+from station.methods.live import LiveAboutGroups
 from station.methods.sessions import (
     is_number,
     load_session_source,
@@ -190,9 +191,9 @@ class GaugeLinearity(Method):
 
     def live(
         self, config: AnalysisConfig, channels: Sequence[str], header: Mapping[str, Any]
-    ) -> LiveAboutMasters:
+    ) -> LiveAboutGroups:
         """The readings about their own master's mean."""
-        return LiveAboutMasters(config, channels, header)
+        return live_about_masters(config, channels, header)
 
     def study(self, inputs: MethodInputs) -> LinearityStudy:
         """The study of ``inputs`` (StationError naming what is missing)."""

@@ -16,6 +16,7 @@ from station.extensions import STEP_KINDS, SiteExtensions, site_extensions
 from station.run.steps.base import PlanItem, StepHandler
 from station.run.steps.check import CheckStep
 from station.run.steps.input import InputStep
+from station.run.steps.parts import PartsStep
 from station.run.steps.repeat import RepeatBlock
 from station.run.steps.sets import CaptureStep, CyclesStep
 from station.run.steps.stroke import StrokeStep
@@ -27,6 +28,7 @@ BUILT_IN: tuple[StepHandler, ...] = (
     ZeroStep(),
     CaptureStep(),
     CyclesStep(),
+    PartsStep(),
     StrokeStep(),
     RepeatBlock(),
 )

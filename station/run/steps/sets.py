@@ -65,9 +65,14 @@ class SetStep(StepHandler):
             if getattr(result, "port_down", False):
                 outcome = CycleOutcome(False, outcome.message, port_down=True)
             return outcome
-        outcome = run.write_cycle(item, {ch: result.readings[ch] for ch in item.step.channels}, by)
+        readings = {ch: result.readings[ch] for ch in item.step.channels}
+        outcome = run.write_cycle(item, readings, by, **self.cycle_fields(run, item))
         self.after_cycle(run, item, by)
         return outcome
+
+    def cycle_fields(self, run: Runner, item: PlanItem) -> dict[str, Any]:
+        """What the step records with the next cycle besides its readings (a part)."""
+        return {}
 
     def after_cycle(self, run: Runner, item: PlanItem, by: str) -> None:
         """What a recorded cycle does to the step (complete it, or say the target is met)."""

@@ -401,7 +401,9 @@ class DashboardScreen(Screen[None]):
         self._action_busy = False
 
     def action_reject(self, reason: str | None = None) -> None:
-        """Reject the last cycle, with a reason (the readings stay in the file)."""
+        """Reject the last cycle, with a reason (the readings stay in the file). The cycle is
+        named when the key is pressed: the one the dialog names is the one rejected, even if
+        more cycles arrive while the reason is typed."""
         state = self.app.current_state()
         runner = self.app.runner
         if not self.live or runner is None or state is None:
@@ -410,17 +412,18 @@ class DashboardScreen(Screen[None]):
         if last is None or last.rejected is not None:
             self._say("There is no captured cycle to reject.", "yellow")
             return
+        cycle = last.cycle
         if reason is not None:
-            self._in_thread(lambda: runner.reject_last(reason))
+            self._in_thread(lambda: runner.reject(cycle, reason))
             return
 
         def reject(text: str | None) -> None:
             if text:
-                self._in_thread(lambda: runner.reject_last(text))
+                self._in_thread(lambda: runner.reject(cycle, text))
 
         self.app.push_screen(
             TextPrompt(
-                f"Reject cycle {last.cycle}",
+                f"Reject cycle {cycle}",
                 "Why? (e.g. the robot was bumped, the cube slipped). The readings stay in "
                 "the file, marked rejected, and are left out of the analysis.",
             ),

@@ -114,6 +114,8 @@ class SetupScreen(ConnectionTestScreen):
         hint = "Tab / Shift+Tab move between fields · F3 tests the line · F2 starts"
         if demo is not None and not resuming:
             hint = "Pre-filled for the demo: press F2 to start (F3 shows live readings first)"
+        elif demo is not None:
+            hint = "The demo resumes on its own running simulator (the line below): press F2"
         if last:
             hint = "Pre-filled from your last session: check robot and line · F2 starts"
         yield Static(Text(hint, style="bold cyan"), id="setup-hint")
@@ -336,7 +338,10 @@ class SetupScreen(ConnectionTestScreen):
             except PortNotOpen as error:
                 self.refuse({"port": explained(error)})
             except StationError as error:
-                self._say("setup", explained(error))
+                if error.field == "port":  # e.g. another program's pseudo-terminal now
+                    self.refuse({"port": explained(error)})
+                else:
+                    self._say("setup", explained(error))
             return
         setup = self._read_setup()
         if setup is None:

@@ -81,6 +81,11 @@ def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
     catalog_procedures = start.procedures
     count = count_field(procedure)
     recorded_port = (header.get("instruments", {}).get("ports") or [{}])[0]
+    if demo is not None:
+        # The demo's line is its own running simulator, also for a resumed session: the one
+        # the file recorded stopped with the demo that ran it, and its pseudo-terminal number
+        # may now be another program's.
+        recorded_port = {}
     if resuming:
         yield Static(recorded_summary(header), id="setup-recorded")
     yield from field_row(
