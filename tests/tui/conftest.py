@@ -5,10 +5,13 @@ from __future__ import annotations
 
 import re
 import time
+import unicodedata
 from collections.abc import Callable, Iterator
 from types import SimpleNamespace
 
 import pytest
+from textual import events
+from textual.keys import REPLACED_KEYS, _character_to_key, _get_unicode_name_from_key
 from textual.widgets import Input, Select
 
 from station.text import figure_decimals
@@ -48,6 +51,33 @@ async def wait_until(pilot, condition: Callable[[], object], timeout: float = 10
         if time.monotonic() > deadline:
             raise AssertionError(f"timed out after {timeout} s waiting for {condition}")
         await pilot.pause(0.02)
+
+
+def key_event(key: str) -> events.Key:
+    """The key event for ``key``, built as ``pilot.press`` builds it ("a", ".", "-", "tab",
+    "shift+tab", "backspace", "enter"), with the character a terminal sends for it."""
+    if len(key) == 1 and not key.isalnum():
+        key = _character_to_key(key)  # "." is "full_stop"
+    try:
+        character = unicodedata.lookup(_get_unicode_name_from_key(REPLACED_KEYS.get(key, key)))
+    except KeyError:
+        character = key if len(key) == 1 else None
+    return events.Key(key, character)
+
+
+async def burst(pilot, *keys: str) -> None:
+    """Type ``keys`` as one burst (a fast typist, a paste over SSH): every key is queued
+    before the app takes the first, as the terminal driver queues the keys of one read.
+    (``pilot.press`` waits for the app to be idle after each key, which hides what goes wrong
+    in between.) Returns once the screen has taken them."""
+    app = pilot.app
+    for key in keys:
+        event = key_event(key)
+        event.set_sender(app)
+        app.post_message(event)
+    # Each key is handed from the app to a widget's queue, and may bubble on from there.
+    for _ in range(3):
+        await pilot.pause()
 
 
 async def open_setup(pilot, robot: str, port: str, operator: str = "operator-1") -> None:
@@ -139,6 +169,7 @@ def tui() -> SimpleNamespace:
         open_setup=open_setup,
         walk_checklist=walk_checklist,
         capture_one=capture_one,
+        burst=burst,
         screen_text=screen_text,
         odd_figures=odd_figures,
     )

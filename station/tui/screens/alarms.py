@@ -35,6 +35,13 @@ from station.session.alarms import (
     ack_fields,
     plain,
 )
+from station.tui.widgets.fields import (
+    FIELD_KEYS,
+    FieldInput,
+    after_fields_take_their_keys,
+    field_key_active,
+    focused_field,
+)
 
 
 def alarm_text(alarm: RecordedAlarm, *, hint: bool = True) -> Text:
@@ -65,7 +72,7 @@ class AckDialog(ModalScreen[AckRequest | None]):
     """Acknowledge one alarm: the cause (from the procedure's list), what it was, and the
     corrective action. Enter on the action saves; Escape cancels."""
 
-    BINDINGS = [Binding("escape", "cancel", "Cancel")]
+    BINDINGS = [Binding("escape", "cancel", "Cancel"), *FIELD_KEYS]
     DEFAULT_CSS = """
     AckDialog { align: center middle; }
     AckDialog > Vertical { width: 76; max-width: 100%; height: auto; max-height: 100%;
@@ -86,8 +93,8 @@ class AckDialog(ModalScreen[AckRequest | None]):
             yield Static(Text(plain(self.alarm.text)))
             yield Static("Cause:")
             yield OptionList(*[Text(plain(cause)) for cause in self.causes], id="ack-cause")
-            yield Input(placeholder="what it was (needed for 'other')", id="ack-text")
-            yield Input(placeholder="corrective action (optional)", id="ack-action")
+            yield FieldInput(placeholder="what it was (needed for 'other')", id="ack-text")
+            yield FieldInput(placeholder="corrective action (optional)", id="ack-action")
             yield Static("", id="ack-error")
             yield Static("Enter on the action saves · Escape cancels", classes="dim")
         yield Footer()
@@ -103,13 +110,23 @@ class AckDialog(ModalScreen[AckRequest | None]):
         event.stop()
         self.query_one("#ack-text", Input).focus()
 
-    def on_input_submitted(self, event: Input.Submitted) -> None:
-        """Enter on the text goes to the action; Enter on the action saves."""
-        event.stop()
-        if event.input.id == "ack-text":
-            self.query_one("#ack-action", Input).focus()
-            return
-        self.action_save()
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """The field keys only while a text has the focus (in the cause list, Enter picks the
+        cause)."""
+        return field_key_active(self, action)
+
+    def action_field_key(self, key: str) -> None:
+        """In a text, at once (before the next key is handed on): Enter on the text goes to
+        the action, Enter on the action saves once both have taken the keys typed before it;
+        Tab and Shift+Tab move on and back."""
+        field = focused_field(self)
+        if key == "previous":
+            self.focus_previous()
+        elif key == "next" or (field is not None and field.id == "ack-text"):
+            self.focus_next()
+        else:
+            texts = list(self.query(FieldInput).results(FieldInput))
+            after_fields_take_their_keys(texts, self.action_save)
 
     def action_save(self) -> None:
         """Check the acknowledgement and return it, or say what is missing."""

@@ -16,14 +16,21 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import Screen
-from textual.widgets import Footer, Input, Label, Static
+from textual.widgets import Footer, Label, Static
 
 from station.errors import StationError
 from station.text import format_value
 from station.tui.remedies import explained
 from station.tui.screens.dialogs import ConfirmScreen, HelpScreen, TextPrompt
 from station.tui.text import shown, shown_line
-from station.tui.widgets.fields import mark_focused_row
+from station.tui.widgets.fields import (
+    FIELD_MOVES,
+    FieldInput,
+    after_fields_take_their_keys,
+    focused_field,
+    mark_focused_row,
+    move_between_fields,
+)
 from station.tui.widgets.step_list import StepList
 
 if TYPE_CHECKING:
@@ -43,7 +50,8 @@ ARRIVAL_ZERO_DOES = (
 ENTER_DOES = {
     "confirm": "Press Enter when this is done.",
     "zero": "Keep the robot still, then press Enter to zero the indicators.",
-    "input": "Type the values, then press Enter to save them.",
+    "input": "Type each value: Enter or Tab goes to the next field, Enter in the last one "
+    "saves them.",
 }
 
 
@@ -56,6 +64,9 @@ class ChecklistScreen(Screen[None]):
         Binding("n", "note", "Note"),
         Binding("f1", "help", "Help"),
         Binding("q", "leave", "Leave (resumable)"),
+        *FIELD_MOVES,
+        # In a step's fields (then "Confirm step" is not the footer's Enter).
+        Binding("enter", "field_key('enter')", "Next field, last saves", priority=True),
     ]
 
     app: StationApp
@@ -163,7 +174,7 @@ class ChecklistScreen(Screen[None]):
                 unit = f" ({field.unit})" if field.unit else ""
                 row = Horizontal(
                     Label(shown(f"{field.label}{unit}"), classes="field-label"),
-                    Input(
+                    FieldInput(
                         compact=True,
                         id=f"input-{field.name}",
                         type="number" if field.type == "number" else "text",
@@ -186,7 +197,7 @@ class ChecklistScreen(Screen[None]):
         mark_focused_row(self, event.widget)
 
     def _focus_first_input(self, tries: int = 20) -> None:
-        fields = list(self.query("#step-inputs Input"))
+        fields = self._step_fields()
         if not fields:
             # Not mounted yet (a busy terminal): look again after the next refresh, so the
             # focus never stays on the step list and the first typed figures go nowhere.
@@ -201,14 +212,30 @@ class ChecklistScreen(Screen[None]):
 
     # -- actions --------------------------------------------------------------------------
 
-    def on_input_submitted(self, event: Input.Submitted) -> None:
-        """Enter in a field moves to the next one, and saves after the last."""
-        fields = list(self.query("#step-inputs Input"))
-        index = fields.index(event.input) if event.input in fields else len(fields) - 1
-        if index + 1 < len(fields):
-            fields[index + 1].focus()
+    def _step_fields(self) -> list[FieldInput]:
+        return list(self.query("#step-inputs FieldInput").results(FieldInput))
+
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """The field keys only while a step's field has the focus (elsewhere Enter confirms
+        the step)."""
+        if action == "field_key":
+            return self.focused in self._step_fields()
+        return True
+
+    def action_field_key(self, key: str) -> None:
+        """In a step's fields, at once (before the next key is handed on): Tab and Shift+Tab
+        go round the fields, Enter goes to the next one and saves after the last, once every
+        field has taken the keys typed before it."""
+        fields = self._step_fields()
+        field = focused_field(self)
+        if field not in fields:
+            return
+        if key == "previous":
+            move_between_fields(self, fields, -1)
+        elif key == "next" or fields.index(field) + 1 < len(fields):
+            move_between_fields(self, fields, 1)
         else:
-            self.action_confirm()
+            after_fields_take_their_keys(fields, self.action_confirm)
 
     def action_confirm(self) -> None:
         """Do the current step through the runner (in a worker: zeroing talks to the gauges)."""
@@ -219,8 +246,8 @@ class ChecklistScreen(Screen[None]):
         kind = state.action.kind
         if kind == "input":
             values = {
-                str(widget.id).removeprefix("input-"): str(widget.value)  # type: ignore[attr-defined]
-                for widget in self.query("#step-inputs Input")
+                str(field.id).removeprefix("input-"): str(field.value)
+                for field in self._step_fields()
             }
             self._do(lambda: runner.submit_input(values))
         elif kind == "zero":

@@ -10,7 +10,7 @@ from textual.screen import ModalScreen, Screen
 from textual.widgets import Footer, Input, Static
 
 from station.tui.text import shown
-from station.tui.widgets.fields import say
+from station.tui.widgets.fields import FieldInput, say
 
 
 class TextPrompt(ModalScreen[str | None]):
@@ -29,7 +29,7 @@ class TextPrompt(ModalScreen[str | None]):
         with Vertical(classes="dialog"):
             yield Static(shown(self._title, style="bold"), classes="dialog-title")
             yield Static(shown(self._prompt))
-            yield Input(placeholder=self._placeholder, id="prompt-input")
+            yield FieldInput(placeholder=self._placeholder, id="prompt-input")
             yield Static("", classes="field-error", id="prompt-error")
             yield Static("Enter to save · Escape to cancel", classes="dim")
         yield Footer()
@@ -88,13 +88,14 @@ HELP_TEXT = """\
 [b]Home[/b]  ↑ ↓ choose · Enter open · n new session · r resume
   v review · q quit
 
-[b]Set-up[/b]  Tab / Shift+Tab move between fields · F3 test connection
-  F2 start. Limits: ±0.001 (a tolerance about nominal 0) or
+[b]Set-up[/b]  Tab or Enter / Shift+Tab move between fields · F3 test
+  connection · F2 start. Limits: ±0.001 (a tolerance about nominal 0) or
   -0.001:0.001 (LSL:USL); one side may be empty. Port: pick a detected
   port or type /dev/ttyUSB0, rfc2217://host:port or socket://host:port.
 
-[b]Checklist[/b]  Enter confirms the step (zeroes at a zero step, saves
-  typed values at an input step) · n note · q leave (resumable)
+[b]Checklist[/b]  Enter confirms the step (zeroes at a zero step) · n note
+  q leave (resumable). At an input step Enter or Tab goes to the next
+  field and Enter in the last one saves the values typed.
 
 [b]Capture[/b]  Space capture a cycle · r reject the last cycle (asks
   why; nothing is deleted) · n note · p pause / continue · f finish

@@ -44,7 +44,7 @@ from station.tui.screens.setup_form import (
     read_header,
 )
 from station.tui.text import shown
-from station.tui.widgets.fields import mark_focused_row, say
+from station.tui.widgets.fields import FIELD_KEYS, field_key_active, mark_focused_row, say
 
 if TYPE_CHECKING:
     from station.procedures import Procedure
@@ -60,6 +60,7 @@ class SetupScreen(ConnectionTestScreen):
         Binding("escape", "back", "Back"),
         Binding("f1", "help", "Help"),
         Binding("space", "press_focused", show=False),
+        *FIELD_KEYS,
     ]
 
     app: StationApp
@@ -246,9 +247,18 @@ class SetupScreen(ConnectionTestScreen):
                 say(self.query_one("#setup-error", Static), "")
         self._confirmed_limits = None
 
-    def on_input_submitted(self, event: Input.Submitted) -> None:
-        """Enter in a field moves to the next one, as in a paper form."""
-        self.focus_next()
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """The field keys only while a field has the focus (on a drop-down or a button, Enter
+        and Tab do what they do there)."""
+        return field_key_active(self, action)
+
+    def action_field_key(self, key: str) -> None:
+        """In a field, at once (before the next key is handed on): Enter and Tab move to the
+        next field, as in a paper form, Shift+Tab to the one before."""
+        if key == "previous":
+            self.focus_previous()
+        else:
+            self.focus_next()
 
     def on_button_pressed(self, event: Button.Pressed) -> None:
         """The two buttons do what F3 and F2 do."""

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 from rich.text import Text
 from textual.app import ComposeResult
 from textual.containers import Horizontal
-from textual.widgets import Input, Label, Select, Static
+from textual.widgets import Label, Select, Static
 
 from station.instruments.protocols import protocol_names
 from station.instruments.transport import list_ports
@@ -26,6 +26,7 @@ from station.plain import plain
 from station.session.model import load_session
 from station.text import LIMIT_HELP, channel_map_text, limits_text
 from station.tui.text import shown
+from station.tui.widgets.fields import FieldInput
 
 if TYPE_CHECKING:
     from station.methods.contract import CountField
@@ -90,7 +91,7 @@ def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
         yield Static(recorded_summary(header), id="setup-recorded")
     yield from field_row(
         "Robot",
-        Input(
+        FieldInput(
             compact=True,
             value=plain(header.get("robot") or (demo.robot if demo else last.get("robot", ""))),
             placeholder="name or asset number of the robot under test",
@@ -101,7 +102,7 @@ def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
     )
     yield from field_row(
         "Operator",
-        Input(
+        FieldInput(
             compact=True,
             value=plain(header.get("operator") or last.get("operator") or login_name()),
             id="operator",
@@ -131,7 +132,7 @@ def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
     )
     yield from field_row(
         "Resolution",
-        Input(
+        FieldInput(
             compact=True,
             value=f"{header.get('resolution') or procedure.resolution:g}",
             id="resolution",
@@ -150,7 +151,7 @@ def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
             value = limits_text(limit.lsl, limit.usl, limit.nominal)
         yield from field_row(
             f"Limits {channel}",
-            Input(
+            FieldInput(
                 compact=True,
                 value=value,
                 placeholder=LIMIT_HELP,
@@ -167,7 +168,7 @@ def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
         yield Static(limits_help, classes="field-hint")
     yield from field_row(
         count.label,
-        Input(
+        FieldInput(
             compact=True,
             value=str(
                 header.get(count.header_key) or (demo.count if demo else None) or count.target
@@ -189,7 +190,7 @@ def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
     )
     yield from field_row(
         "Port",
-        Input(
+        FieldInput(
             compact=True,
             value=port_value,
             placeholder="/dev/ttyUSB0, /dev/pts/N, rfc2217://host:port, socket://host:port",
@@ -216,7 +217,7 @@ def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
         map_text = last["channel_map"]
     yield from field_row(
         "Channel map",
-        Input(compact=True, value=map_text, id="map"),
+        FieldInput(compact=True, value=map_text, id="map"),
         "map",
         "device channel = axis, e.g. 1=x,2=y,3=z",
     )
