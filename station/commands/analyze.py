@@ -181,9 +181,9 @@ def is_session_file(path: Path) -> bool:
     return looks_like_session(first)
 
 
-def load_source(path: Path) -> Any:
+def load_source(path: Path, words: tuple[str, ...] = ()) -> Any:
     """A session file (detected by its header: a ``SessionSource``) or a CSV table of readings
-    (a ``TableSource``)."""
+    (a ``TableSource``; ``words``: its columns that hold words, the method's)."""
     from station.inputfiles import check_regular_file
 
     # A FIFO, a device, a folder or a name too long is refused before a byte is read.
@@ -194,7 +194,7 @@ def load_source(path: Path) -> Any:
         return load_session_source(path)
     from station.session.tables import read_table
 
-    table = read_table(path)
+    table = read_table(path, words)
     cycles = None if table.cycles is None else dict.fromkeys(table.channels, table.cycles)
     if table.channel_cycles is not None:  # a tidy table: its own cycle numbers per channel
         cycles = dict(table.channel_cycles)
@@ -289,7 +289,10 @@ def run(args: argparse.Namespace) -> int:
         if min_n < 0:
             raise StationError(f"--min-n {min_n} must be 0 or more.")
 
-    source = load_source(path)
+    from station.methods import method_of
+
+    # A table is read as the method named reads it (the words of its own columns).
+    source = load_source(path, method_of(args.procedure).word_columns if args.procedure else ())
     channels = source.channels
     for channel, _, _ in per_channel:
         if channel not in channels:
@@ -322,7 +325,6 @@ def run(args: argparse.Namespace) -> int:
     from station.methods import (
         MethodInputs,
         judge,
-        method_of,
         names,
         report_session,
         session_method,

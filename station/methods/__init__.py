@@ -2,9 +2,10 @@
 
 ``repeatability`` (report §2.6), ``relative_accuracy`` (§2.8), ``linearity`` (§2.9),
 ``gauge_check`` (a Type-1 study), ``gauge_linearity`` (AIAG's linearity and bias study),
-``joint_troubleshooting`` (§1.2, §2.8) and ``gain_schedule`` (Part IV). The list is
-:data:`~station.methods.catalog.BUILT_IN`; a site's own come from its installed packages. A
-method package imports the contract and the shared modules beside it, never another method.
+``joint_troubleshooting`` (§1.2, §2.8), ``gain_schedule`` (Part IV) and ``positioning`` (ISO
+230-2, one axis). The list is :data:`~station.methods.catalog.BUILT_IN`; a site's own come
+from its installed packages. A method package imports the contract and the shared modules beside
+it, never another method.
 """
 
 from station.methods.catalog import BUILT_IN, method_of, methods, names, session_method

@@ -280,6 +280,9 @@ class Method(ABC):
     """Whether its batch reads a CSV table by column name (linearity's stroke, s, h, v; a gains
     table's q) rather than each column as a channel: then no column is left out for counting
     the rows (``station analyze``), since 1, 2, 3 ... may be its own positions or joints."""
+    word_columns: ClassVar[tuple[str, ...]] = ()
+    """Columns of its CSV table that hold words, not numbers (an approach's ``direction``,
+    ``up``/``down``): read as text (``MethodInputs.table.words``), never as a channel."""
     drift_chart: ClassVar[bool] = True
     """Whether its report draws the readings over time (cycles in time order; not strokes)."""
     files_in_register: ClassVar[bool] = False

@@ -18,6 +18,7 @@ from __future__ import annotations
 import csv
 import re
 import warnings
+from collections.abc import Collection
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -65,6 +66,12 @@ class ReadingTable:
     placements: np.ndarray | None = None
     """A tidy table's fixture placement of each accepted cycle (aligned with the channels),
     None when it records none."""
+    words: dict[str, tuple[str, ...]] | None = None
+    """The columns read as words, not numbers (a method's, e.g. an approach's ``direction``):
+    each cell stripped, one per data row; None when the table has none."""
+    row_lines: tuple[int, ...] | None = None
+    """The file's line of each data row (as an editor counts), for a table with word columns
+    (read line by line), so a method's sentence about a row can name its line; else None."""
 
     @property
     def rows(self) -> int:
@@ -111,8 +118,12 @@ def _parse_cell(text: str, path: Path, line: int, column: str) -> float:
     )
 
 
-def read_table(path: str | Path) -> ReadingTable:
+def read_table(path: str | Path, words: Collection[str] = ()) -> ReadingTable:
     """Read a CSV table of readings: a header row, ``#`` comments, one column per channel.
+
+    ``words`` names columns (any case) that hold words, not numbers (a method's: an
+    approach's direction ``up``/``down``); they are kept as text in :attr:`ReadingTable.words`
+    and are no channels.
 
     The rows are parsed by numpy in one streaming pass (``numpy.loadtxt``, no per-cell Python);
     a file it cannot take is read again line by line to name the first fault. Raises
@@ -142,6 +153,9 @@ def read_table(path: str | Path) -> ReadingTable:
                         f"{plain(path)} has a header but no readings; add one row per cycle."
                     )
                 return _read_tidy(path, names, data_rows, tuple(comments))
+            word_names = {name.lower() for name in words}
+            if any(name.lower() in word_names for name in names):
+                return _read_with_words(handle, path, header_line, names, word_names, comments)
             channel_positions = _check_header(names, header_line, path)
             start = handle.tell()
             try:
@@ -275,6 +289,84 @@ def _read_tidy(
         excluded_cycles=tuple(sorted(excluded - {c for cs in cycles.values() for c in cs})),
         placements=placements,
         times=times,
+    )
+
+
+WORDS_TABLE_ROWS = 1_000_000
+"""The most data rows of a table with word columns (read line by line, not by numpy): a test
+of one axis has tens."""
+
+
+def _read_with_words(
+    handle: Any,
+    path: Path,
+    header_line: int,
+    names: list[str],
+    word_names: set[str],
+    comments: list[str],
+) -> ReadingTable:
+    """A table some of whose columns (``word_names``, lower case) hold words: read line by line,
+    every other cell a number as in :func:`read_table` (the same sentences for a bad cell)."""
+    is_word = [name.lower() in word_names for name in names]
+    numeric = [i for i, word in enumerate(is_word) if not word]
+    channel_positions = [i for i in numeric if names[i].lower() not in INDEX_COLUMNS]
+    _check_header(names, header_line, path)
+    if not channel_positions:
+        raise StationError(
+            f"{plain(path)}: line {header_line}: no numeric columns beside "
+            f"{', '.join(n for n, w in zip(names, is_word, strict=True) if w)}; add the readings."
+        )
+    _check_header(names, header_line, path)
+    rows: list[list[float]] = []
+    texts: list[list[str]] = []
+    lines: list[int] = []
+    for number, line in enumerate(handle, start=header_line + 1):
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            if stripped.startswith("#"):
+                comments.append(stripped[1:].strip())
+            continue
+        cells = _cells(line, path, number)
+        if len(cells) != len(names):
+            raise StationError(
+                f"{plain(path)}: line {number} has {len(cells)} cells but the header has "
+                f"{len(names)} columns; every row needs one cell per column."
+            )
+        values = [_parse_cell(cells[i], path, number, names[i]) for i in numeric]
+        for i, value in zip(numeric, values, strict=True):
+            if names[i].lower() == "cycle" and (
+                value != int(value) or value < 1 or value > CYCLE_LIMIT
+            ):
+                raise StationError(
+                    f"{plain(path)}: line {number}, column {plain(names[i], limit=40)!r}: "
+                    f"{plain(cells[i].strip(), limit=40)!r} is not a cycle number (1, 2, 3 ...); "
+                    "fix the cell or delete the row."
+                )
+        rows.append(values)
+        lines.append(number)
+        texts.append([cells[i].strip() for i, word in enumerate(is_word) if word])
+        if len(rows) > WORDS_TABLE_ROWS:
+            raise StationError(
+                f"{plain(path)} has more than {WORDS_TABLE_ROWS:,} rows; split it into smaller "
+                "files."
+            )
+    if not rows:
+        raise StationError(f"{plain(path)} has a header but no readings; add one row per cycle.")
+    data = np.asarray(rows, dtype=np.float64)
+    column = {i: data[:, k] for k, i in enumerate(numeric)}
+    cycle = next((i for i in numeric if names[i].lower() == "cycle"), None)
+    time = next((i for i in numeric if names[i].lower() == "t"), None)
+    word_positions = [i for i, word in enumerate(is_word) if word]
+    return ReadingTable(
+        path=path,
+        channels={names[i]: np.ascontiguousarray(column[i]) for i in channel_positions},
+        index_columns=tuple(name for name in names if name.lower() in INDEX_COLUMNS),
+        comments=tuple(comments),
+        cycles=None if cycle is None else column[cycle].astype(np.int64),
+        excluded_cycles=excluded_in_comments(comments),
+        times=None if time is None else np.ascontiguousarray(column[time]),
+        words={names[i]: tuple(row[k] for row in texts) for k, i in enumerate(word_positions)},
+        row_lines=tuple(lines),
     )
 
 
