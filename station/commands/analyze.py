@@ -58,8 +58,10 @@ master with its t-test, its regression on the size, linearity = |slope|·PV with
 when given); --procedure joint_troubleshooting reads joint, x, y, z (and
 optionally lever: the joint's axis to the cube) and names the suspect joint;
 --procedure gain_schedule reads q and one column per gain (see also station
-gains fit). A session file is analysed as its procedure declares (its
-`analysis`) unless --procedure says otherwise.
+gains fit); --procedure positioning reads target, direction (up/down or +/-),
+actual or deviation and an optional cycle, and gives the ISO 230-2 figures of
+one axis (B, R, E, M, A, up, down and both). A session file is analysed as
+its procedure declares (its `analysis`) unless --procedure says otherwise.
 
 exit codes:
   0  analysed

@@ -83,7 +83,7 @@ def test_the_text_report(tmp_path: Path):
     text = done.stdout
     assert text.startswith("AXIS POSITIONING REPORT (ISO 230-2) ON axis.csv")
     assert "AXIS POSITIONING (ISO 230-2): 3 targets, 30 approaches" in text
-    assert "         100    +5.0000    +4.0000    0.5000    0.5000    +1.0000    3.0000" in text
+    assert "       100    +5.0000    +4.0000    0.5000    0.5000    +1.0000    3.0000" in text
     assert "R = 7.0000  repeatability, the largest R_i (at 0: 2s↑ + 2s↓ + |B_i|)" in text
     assert "E = 6.0000  systematic error (mean 100↑ - mean 0↓)" in text
     assert "A = 9.0000  accuracy (mean+2s 100↑ - mean-2s 0↓)" in text

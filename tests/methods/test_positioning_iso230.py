@@ -114,8 +114,8 @@ def test_set_a_report_names_where_each_extreme_lies():
     assert "M = 4.0000  mean bidirectional error (mean at 100 - mean at 0)" in text
     assert "A = 9.0000  accuracy (mean+2s 100↑ - mean-2s 0↓)" in text
     assert "note: only 3 targets: ISO 230-2 asks for at least 5" in text
-    # The figures fit 80 columns (a note is wrapped by the report, as every method's).
-    assert all(len(line) <= 80 for line in text.splitlines() if "note:" not in line)
+    # The figures fit the TUI summary's 74 columns (a note is wrapped, as every method's).
+    assert all(len(line) <= 74 for line in text.splitlines() if "note:" not in line)
 
 
 def test_set_b_every_figure_by_hand():

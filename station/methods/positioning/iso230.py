@@ -276,13 +276,13 @@ class AxisPositioning:
         unit = f" in {self.unit}" if self.unit else ""
         lines = [
             f"AXIS POSITIONING (ISO 230-2): {len(self.targets)} targets, {approaches} approaches",
-            f"  deviations (actual - target){unit}; ↑ approached moving up, ↓ moving down",
-            f"  {'target':>10} {'mean↑':>10} {'mean↓':>10} {'s↑':>9} {'s↓':>9} "
+            f"  deviations (actual - target){unit}; ↑ moving up, ↓ moving down",
+            f"  {'target':>8} {'mean↑':>10} {'mean↓':>10} {'s↑':>9} {'s↓':>9} "
             f"{'B_i':>10} {'R_i':>9}",
         ]
         for t in self.targets:
             lines.append(
-                f"  {t.target:>10g} {g(t.mean_up, True):>10} {g(t.mean_down, True):>10} "
+                f"  {t.target:>8g} {g(t.mean_up, True):>10} {g(t.mean_down, True):>10} "
                 f"{g(t.s_up):>9} {g(t.s_down):>9} {g(t.reversal, True):>10} {g(t.r):>9}"
             )
         worst_b = max(self.targets, key=lambda t: abs(t.reversal))

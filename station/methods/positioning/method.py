@@ -25,6 +25,8 @@ from station.errors import StationError
 from station.methods.contract import (
     Chart,
     ChartKit,
+    DemoDisplay,
+    DemoRig,
     Judgement,
     Method,
     MethodInputs,
@@ -50,6 +52,7 @@ if TYPE_CHECKING:
     from _typeshed import SupportsWrite
 
     from station.analysis.summary import AnalysisConfig
+    from station.instruments.simulator import GaugeSpec
     from station.session.model import Session
     from station.session.tables import ReadingTable
 
@@ -57,6 +60,13 @@ NAME = "positioning"
 TARGET_FIELD = re.compile(r"target_(\d+)")
 """The typed fields that hold the targets, numbered along the axis: ``target_1``, ..."""
 TABLE_COLUMNS = "target, direction and actual (or deviation)"
+DEMO_TARGETS = (10.3, 97.6, 203.1, 301.9, 398.4)
+"""The demo axis's targets (mm): five over a 400 mm travel, spaced unevenly as ISO 230-2 asks."""
+DEMO_SLOPE = 5e-5
+"""The demo axis stops long by 50 µm per metre of travel."""
+DEMO_BACKLASH = 0.020
+"""The demo axis's lost motion at a reversal (mm): a reversal B_i of -0.020 at every target."""
+DEMO_NOISE = 0.002
 
 
 Approaches = tuple[np.ndarray, np.ndarray, np.ndarray]
@@ -224,11 +234,25 @@ def deviation_chart(result: AxisPositioning, approaches: Approaches, kit: ChartK
             label=f"mean {word} ± 2s",
         )  # fmt: skip
     axes.axhline(0.0, color="grey", linestyle=":")
-    axes.set_title(f"Deviation against the target: E {result.e:.4g}, R {result.r:.4g}")
+    figures = f"E {result.e:.3g}, R {result.r:.3g}, B {result.b:.3g}" + (f" {unit}" if unit else "")
+    axes.set_title(f"Deviation against the target: {figures}")
     axes.set_xlabel("target" + suffix)
     axes.set_ylabel("deviation (actual - target)" + suffix)
     axes.legend(loc="best", fontsize=7)
     return figure
+
+
+def _targets_display(model: Any, placement: int | None, unit: str) -> DemoDisplay | None:
+    """What the simulated axis's program lists: the targets it stops at, to be typed."""
+    if placement is not None:
+        return None
+    targets = model.targets
+    return DemoDisplay(
+        label="The axis's test program (simulated)",
+        text="targets " + ", ".join(f"{t:g}" for t in targets) + " mm",
+        values={f"target_{i}": t for i, t in enumerate(targets, start=1)},
+        hint="type the targets shown above",
+    )
 
 
 # -- the method ---------------------------------------------------------------------------------
@@ -253,6 +277,7 @@ class Positioning(Method):
     json_key = "iso230_2"
     export_layout = "wide"
     drift_chart = False
+    demo_words = "a linear scale along an axis with a positioning error and backlash"
     placement_words = PlacementWords(
         label="Runs",
         noun="runs of the test cycle",
@@ -312,6 +337,21 @@ class Positioning(Method):
         for _, run, target, up, reading in found:
             writer.writerow((number(target), UP if up else DOWN, run, number(reading)))
         return len(found)
+
+    def demo_rig(self, gauge: GaugeSpec, seed: int, *, stroke_points: int) -> DemoRig:
+        """A 1 µm scale along a 400 mm axis that stops long by 50 µm/m and loses 0.020 mm
+        at each reversal, with 0.002 mm of scatter (σ), running the standard test cycle."""
+        from station.instruments.axis_model import AxisPositioningModel
+
+        model = AxisPositioningModel(
+            DEMO_TARGETS, slope=DEMO_SLOPE, backlash=DEMO_BACKLASH, noise=DEMO_NOISE
+        )
+        return DemoRig(
+            model,
+            "a simulated linear scale along an axis with backlash (seeded)",
+            channel_map={"1": "s"},
+            display=_targets_display,
+        )
 
 
 METHOD = Positioning()
