@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from properties import examples
 
+from station.analysis.summary import AnalysisConfig
 from station.errors import StationError
 from station.methods.positioning.iso230 import (
     axis_positioning,
@@ -17,6 +18,8 @@ from station.methods.positioning.iso230 import (
     direction_of,
     standard_cycle,
 )
+from station.methods.positioning.live import about_approaches, stops
+from station.methods.positioning.method import typed_targets
 
 PATTERN = (-1.0, -1.0, 0.0, 1.0, 1.0)
 """Five approaches about their mean: the sum of squares is 4, so s = √(4/4) = 1 exactly; scaled
@@ -206,3 +209,33 @@ def test_the_bidirectional_figures_cover_each_direction(rows):
     assert result.a >= max(result.a_up, result.a_down) - tiny
     assert result.m <= result.e + tiny
     assert result.b <= result.r + tiny
+
+
+# -- a session's targets and its live analysis ------------------------------------------------
+
+
+def test_the_targets_typed_are_read_in_their_order_and_must_rise():
+    events = [
+        {"step": "targets", "values": {"target_2": 97.6, "target_10": 500.0, "target_1": 10.3}},
+        {"step": "other", "values": {"note": "x"}},
+    ]
+    assert typed_targets(events) == [10.3, 97.6, 500.0]
+    with pytest.raises(StationError, match=r"target_2 \(5\) is not beyond target_1 \(10.3\)"):
+        typed_targets([{"values": {"target_1": 10.3, "target_2": 5.0}}])
+    with pytest.raises(StationError, match="no targets are typed in yet"):
+        typed_targets([{"values": {"reference": 1.0}}])
+
+
+def test_the_live_analysis_is_each_stop_about_its_own_approach():
+    """Two runs of a 2-target cycle (4 stops each): the k-th stop of each run is one approach,
+    so the live readings are each stop less the mean of the two runs' same stop."""
+    stops_taken = [(10.0, 20.0, 20.4, 10.4), (10.2, 20.2, 20.4, 10.8)]
+    rows = [
+        ({"s": value}, number, None, run)
+        for number, (run, value) in enumerate(
+            ((run, v) for run, values in enumerate(stops_taken, start=1) for v in values), start=1
+        )
+    ]
+    residuals = about_approaches(rows, AnalysisConfig(), ("s",)).channels["s"].readings
+    assert list(residuals) == pytest.approx([-0.1, -0.1, 0, -0.2, 0.1, 0.1, 0, 0.2])
+    assert stops([1, 1, 2, 1, 2]) == [(1, 0), (1, 1), (2, 0), (1, 2), (2, 1)]
