@@ -62,8 +62,11 @@ optionally lever: the joint's axis to the cube) and names the suspect joint;
 gains fit); --procedure gage_rr reads part, appraiser (or operator), trial,
 value (part and appraiser may be names) and gives the crossed Gage R&R by ANOVA
 and by average and range, %GRR against --tolerance T when given, ndc, and
-AIAG's verdict. A session file is analysed as its procedure declares (its
-`analysis`) unless --procedure says otherwise.
+AIAG's verdict; --procedure positioning reads target, direction (up/down or
++/-), actual or deviation and an optional cycle, and gives the ISO 230-2
+figures of one axis (B, R, E, M, A, up, down and both). A session file is
+analysed as its procedure declares (its `analysis`) unless --procedure says
+otherwise.
 
 exit codes:
   0  analysed

@@ -2,8 +2,8 @@
 
 ``repeatability`` (report §2.6), ``relative_accuracy`` (§2.8), ``linearity`` (§2.9),
 ``gauge_check`` (a Type-1 study), ``gauge_linearity`` (AIAG's linearity and bias study),
-``gage_rr`` (AIAG's crossed Gage R&R), ``joint_troubleshooting`` (§1.2, §2.8) and
-``gain_schedule`` (Part IV). The list is
+``gage_rr`` (AIAG's crossed Gage R&R), ``joint_troubleshooting`` (§1.2, §2.8),
+``gain_schedule`` (Part IV) and ``positioning`` (ISO 230-2, one axis). The list is
 :data:`~station.methods.catalog.BUILT_IN`; a site's own come from its installed packages. A
 method package imports the contract and the shared modules beside it, never another method.
 """

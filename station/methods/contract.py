@@ -284,8 +284,9 @@ class Method(ABC):
     table's q) rather than each column as a channel: then no column is left out for counting
     the rows (``station analyze``), since 1, 2, 3 ... may be its own positions or joints."""
     label_columns: ClassVar[tuple[str, ...]] = ()
-    """The columns of its CSV table that hold names, not numbers (a Gage R&R's part and
-    appraiser): ``station analyze`` keeps their cells as text (``ReadingTable.labels``)."""
+    """The columns of its CSV table that hold words, not numbers (a Gage R&R's part and
+    appraiser, an approach's direction): ``station analyze`` keeps their cells as text
+    (``ReadingTable.labels``), never as a channel."""
     drift_chart: ClassVar[bool] = True
     """Whether its report draws the readings over time (cycles in time order; not strokes)."""
     files_in_register: ClassVar[bool] = False

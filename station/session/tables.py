@@ -70,7 +70,10 @@ class ReadingTable:
     None when it records none."""
     labels: dict[str, tuple[str, ...]] = field(default_factory=dict)
     """The label columns the caller named that the table has (by their name in the file):
-    each row's cell as text, stripped."""
+    each row's cell as text, stripped (a Gage R&R's part, an approach's ``direction``)."""
+    row_lines: tuple[int, ...] | None = None
+    """The file's line of each data row (as an editor counts), for a table with label columns
+    (read line by line), so a method's sentence about a row can name its line; else None."""
 
     @property
     def rows(self) -> int:
@@ -120,7 +123,8 @@ def _parse_cell(text: str, path: Path, line: int, column: str) -> float:
 def read_table(path: str | Path, labels: Collection[str] = ()) -> ReadingTable:
     """Read a CSV table of readings: a header row, ``#`` comments, one column per channel.
     The columns named in ``labels`` (compared case-insensitively; a Gage R&R's part and
-    appraiser) hold names: their cells are kept as text in :attr:`ReadingTable.labels`.
+    appraiser, an approach's direction ``up``/``down``) hold words: their cells are kept as
+    text in :attr:`ReadingTable.labels` and are no channels.
 
     The rows are parsed by numpy in one streaming pass (``numpy.loadtxt``, no per-cell Python);
     a file it cannot take is read again line by line to name the first fault. Raises
@@ -154,9 +158,10 @@ def read_table(path: str | Path, labels: Collection[str] = ()) -> ReadingTable:
             label_positions = [i for i, name in enumerate(names) if name.lower() in wanted]
             channel_positions = _check_header(names, header_line, path, label_positions)
             label_cells: dict[str, tuple[str, ...]] = {}
+            row_lines = None
             if label_positions:
                 # Text beside the numbers: read row by row (a study's table is small).
-                data, label_cells = _read_labelled(
+                data, label_cells, row_lines = _read_labelled(
                     handle, path, header_line, names, label_positions
                 )
             else:
@@ -206,6 +211,7 @@ def read_table(path: str | Path, labels: Collection[str] = ()) -> ReadingTable:
             None,
         ),
         labels=label_cells,
+        row_lines=row_lines,
     )
 
 
@@ -229,10 +235,12 @@ def _read_numbers(handle: Any, path: Path, header_line: int, names: list[str]) -
 
 def _read_labelled(
     handle: Any, path: Path, header_line: int, names: list[str], label_positions: list[int]
-) -> tuple[np.ndarray, dict[str, tuple[str, ...]]]:
+) -> tuple[np.ndarray, dict[str, tuple[str, ...]], tuple[int, ...]]:
     """The data rows of a table with label columns: the numbers of the other columns (one row
-    each) and each label column's cells as text; a fault names its line and column."""
+    each), each label column's cells as text and each row's line in the file; a fault names
+    its line and column."""
     rows: list[list[float]] = []
+    lines: list[int] = []
     labels: dict[int, list[str]] = {i: [] for i in label_positions}
     for line_number, line in enumerate(handle, start=header_line + 1):
         if not line.strip() or line.lstrip().startswith("#"):
@@ -255,9 +263,10 @@ def _read_labelled(
             else:
                 row.append(_parse_cell(cell, path, line_number, name))
         rows.append(row)
+        lines.append(line_number)
     width = len(names) - len(label_positions)
     data = np.asarray(rows, dtype=np.float64).reshape(len(rows), width)
-    return data, {names[i]: tuple(cells) for i, cells in labels.items()}
+    return data, {names[i]: tuple(cells) for i, cells in labels.items()}, tuple(lines)
 
 
 _REJECTED_COMMENT = re.compile(r"^rejected cycle (\d+)\b")

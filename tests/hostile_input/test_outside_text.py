@@ -41,6 +41,7 @@ PROCEDURES = (
     "gage_rr",
     "joint_troubleshooting",
     "gain_schedule",
+    "positioning",
 )
 
 

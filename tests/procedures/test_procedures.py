@@ -349,6 +349,7 @@ def test_the_analysis_kind_defaults_by_step_kinds(tmp_path: Path) -> None:
         "gage_rr": "gage_rr",
         "joint_troubleshooting": "joint_troubleshooting",
         "gain_schedule": "gain_schedule",
+        "positioning": "positioning",
     }
 
 
