@@ -127,7 +127,7 @@ def test_missing_columns_are_named(tmp_path: Path):
     assert "missing actual (or deviation) (it has target, direction)" in line
     table.write_text("direction,cycle\nup,1\n")
     line = one_line(analyze(table, "--procedure", "positioning"))
-    assert "no numeric columns beside direction; add the readings" in line
+    assert "no channel columns in the header 'direction,cycle'" in line
     table.write_text("target,direction,x\n0,up,1\n")
     assert "missing actual (or deviation)" in one_line(analyze(table, "--procedure", "positioning"))
     table.write_text("target,direction,actual,deviation\n0,up,1,1\n")
