@@ -30,7 +30,7 @@ from station.run.state import (
     StepView,
     StrokeOutcome,
 )
-from station.text import format_value, value_decimals
+from station.text import figure_decimals, format_figure
 
 __all__ = [
     "ACTION_KINDS",
@@ -50,12 +50,12 @@ __all__ = [
     "SessionSetup",
     "StepView",
     "StrokeOutcome",
-    "format_value",
+    "figure_decimals",
+    "format_figure",
     "open_gauges",
     "plan_steps",
     "procedure_limits",
     "resume_setup",
     "set_problem",
     "setup_from_header",
-    "value_decimals",
 ]

@@ -47,8 +47,8 @@ def test_full_headless_session(simulator, procedures, tmp_path):
     lines = done.stdout.splitlines()
     cycle_lines = [line for line in lines if line.startswith("cycle ")]
     # Two single captures (x, y) in the repeat block, then four cycles of x, y, z: values at
-    # the 0.0001 in gauges' four decimals.
-    assert re.fullmatch(r"cycle 1 x=[+-]\d\.\d{4} y=[+-]\d\.\d{4}", cycle_lines[0])
+    # one decimal beyond the 0.0001 in gauges' step, as every figure.
+    assert re.fullmatch(r"cycle 1 x=[+-]\d\.\d{5} y=[+-]\d\.\d{5}", cycle_lines[0])
     assert re.fullmatch(r"cycle 6 x=\S+ y=\S+ z=\S+", cycle_lines[-1])
     assert len(cycle_lines) == 6
     path = Path(lines[-2].removeprefix("session file: "))
