@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from station.errors import StationError
+
 FORMATS = ("txt", "md", "html")
 
 
@@ -27,7 +29,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("file", metavar="FILE", help="the session file (.jsonl)")
     parser.add_argument("--format", choices=FORMATS, default=None, help="txt (default), md or html")
     parser.add_argument(
-        "-o", "--output", metavar="OUT", help="write to OUT instead of standard output"
+        "-o",
+        "--output",
+        metavar="OUT",
+        help="write to OUT instead of standard output (html needs it at a terminal)",
     )
     parser.add_argument("--force", action="store_true", help="overwrite OUT when it exists")
     parser.set_defaults(func=run)
@@ -50,6 +55,13 @@ def run(args: argparse.Namespace) -> int:
     fmt = output_format(args.format, args.output)
     source = Path(args.file)
     if not args.output:
+        if fmt == "html" and sys.stdout.isatty():
+            # A page of inline SVG charts (some 170 KB) is no text to read at a terminal; a
+            # pipe or a redirect still gets it.
+            raise StationError(
+                "an HTML report is a page for a browser, not for the terminal: "
+                f"write it to a file with -o {source.with_suffix('.html').name}"
+            )
         sys.stdout.write(render_report(source, fmt))
         return 0
     out = Path(args.output)
