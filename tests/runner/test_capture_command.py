@@ -163,10 +163,11 @@ def test_unit_and_resolution_options(procedures, tmp_path):
     session = load_session(path, recover=False)
     assert (session.header["unit"], session.header["resolution"]) == ("mm", 0.001)
     assert session.header["limits"]["x"]["usl"] == 0.05
-    assert "Unit: mm   Resolution: 0.001 " in done.stdout
+    # The gauge step and every figure one decimal beyond it (the one number format).
+    assert "Unit: mm   Resolution: 0.0010 " in done.stdout
     cycle_lines = [line for line in done.stdout.splitlines() if line.startswith("cycle ")]
     assert len(cycle_lines) == 3
-    assert all(re.fullmatch(r"cycle \d (\w=[+-]\d+\.\d{3} ?){3}", line) for line in cycle_lines)
+    assert all(re.fullmatch(r"cycle \d (\w=[+-]\d+\.\d{4} ?){3}", line) for line in cycle_lines)
 
 
 def test_gauges_in_another_unit_are_refused_before_the_session(procedures, tmp_path):
