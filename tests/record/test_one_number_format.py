@@ -129,3 +129,9 @@ def test_the_value_listed_is_the_value_saved_and_judged(captured):
             marked += beyond
         assert row.rstrip().endswith("out of spec" if beyond_any else "ok"), row
     assert marked
+    # The HTML report shows an out-of-spec row as such, not greyed like a rejected one.
+    html = captured["tight"].with_suffix(".rows.html")
+    assert run_station("report", captured["tight"], "-o", html).returncode == 0
+    rows = re.findall(r"<tr(?: class=\"(\w+)\")?><td>\d+</td>.*?</tr>", html.read_text())
+    beyond_rows = [line for line in report.splitlines() if line.endswith(" out of spec")]
+    assert rows.count("out") == len(beyond_rows) > 0 and "rejected" not in rows
