@@ -29,7 +29,7 @@ _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 # -- numbers at a resolution ------------------------------------------------------------------
 
 
-def value_decimals(resolution: float | None) -> int:
+def _step_decimals(resolution: float | None) -> int:
     """How many decimals a gauge of ``resolution`` shows (0.0001 -> 4, 0.0005 -> 4, 0.002 -> 3,
     1e-05 -> 5); 5 when the resolution is unknown."""
     if resolution is None or not math.isfinite(resolution) or resolution <= 0:
@@ -38,46 +38,39 @@ def value_decimals(resolution: float | None) -> int:
     return max(0, -int(exponent))
 
 
-def format_value(value: float | None, resolution: float | None, *, signed: bool = True) -> str:
-    """A reading as the gauge shows it: signed, at its resolution's decimals (``+0.0012``);
-    ``-`` when undefined.
-
-    Rounding to the display is what the operator reads; the file keeps the full value."""
-    if value is None or not math.isfinite(value):
-        return NOT_AVAILABLE
-    decimals = value_decimals(resolution)
-    if not signed:
-        return f"{value:.{decimals}f}"
-    text = f"{value:+.{decimals}f}"
-    # -0.00004 at four decimals would read "-0.0000": a zero has no sign worth showing.
-    return "+" + text[1:] if text.startswith("-") and not text.strip("-0.") else text
-
-
 def figure_decimals(resolution: float | None) -> int:
-    """Decimals of a figure computed from readings (a mean, σ, a limit, a control line, a zero
-    taken as a mean): one beyond the gauge's step (0.0001 -> 5), so an average keeps the digit
-    it resolves. Every screen and report that shows statistics writes every figure in the
-    session's unit with these decimals, readings included, so one screen has one format."""
-    return value_decimals(resolution) + 1
+    """Decimals of every figure in the session's unit: one beyond the gauge's step (0.0001 ->
+    5; 6 when the step is unknown). A reading after a zero taken as a mean of several readings
+    is no whole step (+0.00103 at a 0.0001 in gauge), and a mean or a limit keeps the digit it
+    resolves: at the step's own decimals the value shown would not be the value judged."""
+    return _step_decimals(resolution) + 1
 
 
-def format_figure(value: float | None, resolution: float | None, *, signed: bool = True) -> str:
-    """A figure at :func:`figure_decimals`: signed for a position (``+0.00012``, a mean, a
-    limit, an offset), unsigned for a spread (``signed=False``: σ, range); ``-`` when
-    undefined. Never in scientific notation."""
-    if value is None or not math.isfinite(value):
+def format_figure(
+    value: float | None, resolution: float | None, *, signed: bool = True, unit: str = ""
+) -> str:
+    """The one number format of the station: a figure in the session's unit (a reading, a
+    zero, a mean, σ, a limit, a control line, an offset) at :func:`figure_decimals`, signed for
+    a position (``+0.00012``: a reading, a mean, a limit, an offset) and unsigned for a spread
+    or a size (``signed=False``: σ, a range, a tolerance), never in scientific notation, with
+    `` unit`` after it when given; ``-`` when undefined.
+
+    Every screen, message, alarm, command and report writes its figures with this function, so
+    a value reads the same wherever it is shown. Rounding is for the eye only: the session file
+    keeps the full value."""
+    if value is None or isinstance(value, bool) or not math.isfinite(value):
         return NOT_AVAILABLE
     decimals = figure_decimals(resolution)
-    if not signed:
-        return f"{value:.{decimals}f}"
-    text = f"{value:+.{decimals}f}"
-    # -0.000004 at five decimals would read "-0.00000": a zero has no sign worth showing.
-    return "+" + text[1:] if text.startswith("-") and not text.strip("-0.") else text
+    text = f"{value:+.{decimals}f}" if signed else f"{value:.{decimals}f}"
+    if text.startswith("-") and not text.strip("-0."):
+        # -0.000004 at five decimals would read "-0.00000": a zero has no sign worth showing.
+        text = ("+" if signed else "") + text[1:]
+    return f"{text} {unit}" if unit else text
 
 
-def format_spread(value: float | None, resolution: float | None) -> str:
-    """A spread (σ, range) at one decimal more than the gauge shows, unsigned."""
-    return format_figure(value, resolution, signed=False)
+def format_spread(value: float | None, resolution: float | None, *, unit: str = "") -> str:
+    """A spread or a size (σ, a range, a tolerance): :func:`format_figure` unsigned."""
+    return format_figure(value, resolution, signed=False, unit=unit)
 
 
 def format_index(value: float | None) -> str:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -22,6 +23,7 @@ from pathlib import Path
 import pytest
 
 from station.cli import main as station_main
+from station.text import figure_decimals
 
 STATION = [sys.executable, "-m", "station"]
 """The station command as this interpreter runs it, for a real process."""
@@ -195,3 +197,54 @@ def reopen_number(path: str, terminals: list[Terminal]) -> Terminal:
     finally:
         for terminal in held:
             terminal.close()
+
+
+FIGURE = re.compile(r"(?<![\w.-])[-+]?\d+\.(\d+)(?![\w.%-])")
+"""A number with decimals, standing alone (not a percent, nor part of a hash, a date, a uuid or
+a file name)."""
+SCIENTIFIC = re.compile(r"(?<![\w.-])[-+]?\d+(?:\.\d+)?[eE][-+]?\d+(?![\w.-])")
+SIGNED_SPREAD = re.compile(r"\b(?:σ|SIGMA:?|sigma|RANGE:?|range|spread)\s+[-+]\d")
+UNSIGNED_POSITION = re.compile(
+    r"(?:(?<!MR )\b(?:UCL|LCL|CENTER|centre|center|LSL|USL|MEAN|AVERAGE|average|offset|"
+    r"nominal|NOMINAL|bias|EWMA|limit|line)\b:?\s*\(?|=)\d+\.\d"
+)
+"""A position (a limit, a control line, a mean, an offset, a reading after ``=``) written
+without its sign (a moving range's ``MR UCL`` is a spread)."""
+DIMENSIONLESS = re.compile(
+    r"(?:\b(?:p|r|a1|t|W|statistic|T²|F|Cp|Cpk|Cpu|Cpl|Pp|Ppk|ratio|lambda|SKEWNESS a1:)\s*[=<]?\s*"
+    r"|CI )$"
+)
+"""What stands just before a number that is no figure in the unit (a p-value, a statistic,
+an index, a σ ratio's interval)."""
+
+
+def odd_figures(text: str, resolution: float | None = 0.0001) -> list[str]:
+    """The figures in ``text`` that break the one number format (empty when there are none): a
+    number in scientific notation, a signed spread, an unsigned position, or a figure with more
+    than two decimals (an index or a percent has two) but other than the figures' decimals at
+    ``resolution``, unless a dimensionless label stands before it (``p = 0.003``). Each is
+    given with the text around it."""
+
+    def around(match: re.Match[str], line: str) -> str:
+        start, end = max(0, match.start() - 40), match.end() + 20
+        return f"{match.group(0)!r} in {line[start:end]!r}"
+
+    decimals = figure_decimals(resolution)
+    odd = [around(match, text) for match in SCIENTIFIC.finditer(text)]
+    odd += [around(match, text) for match in SIGNED_SPREAD.finditer(text)]
+    odd += [around(match, text) for match in UNSIGNED_POSITION.finditer(text)]
+    lines = text.splitlines()
+    # The teach pendant's coordinates are typed as the pendant shows them (its own decimals).
+    pendant = next((i for i, line in enumerate(lines) if "PENDANT" in line), None)
+    if pendant is not None:
+        end = next((i for i in range(pendant, len(lines)) if not lines[i].strip()), len(lines))
+        lines = lines[:pendant] + lines[end:]
+    for line in lines:
+        for match in FIGURE.finditer(line):
+            places = len(match.group(1))
+            if DIMENSIONLESS.search(line[: match.start()]):
+                continue
+            # Two decimals: an index (Cp, Cpk, a₁, a percent); anything longer is a figure.
+            if places > 2 and places != decimals:
+                odd.append(around(match, line))
+    return odd

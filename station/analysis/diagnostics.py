@@ -153,7 +153,8 @@ def normality(
     ties = None
     if resolution and resolution > sd / 4:
         ties = (
-            f"the gauge step {resolution:g} is over a quarter of sigma "
+            f"the gauge step {format_figure(resolution, resolution, signed=False)} is over a "
+            "quarter of sigma "
             f"({format_figure(sd, resolution, signed=False)}): tied "
             "readings make the test reject normal data more often"
         )

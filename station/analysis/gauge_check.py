@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from station.errors import StationError
+from station.text import format_figure
 
 #: K: the share of the tolerance (in %) the gauge's spread may take.
 PERCENT_OF_TOLERANCE = 20.0
@@ -121,16 +122,20 @@ class GaugeCheck:
 
     def lines(self) -> list[str]:
         """The study as plain report lines (the verdict first, then the figures and notes)."""
-        unit = f" {self.unit}" if self.unit else ""
+
+        def figure(value: float, *, signed: bool = True) -> str:
+            # The one number format: one decimal beyond the gauge step, never 1e-05.
+            return format_figure(value, self.resolution, signed=signed, unit=self.unit)
 
         def index(value: float | None) -> str:
             return "undefined (no spread)" if value is None else f"{value:.2f}"
 
         lines = [
             f"GAUGE CHECK (TYPE-1 STUDY): {self.verdict.upper()}",
-            f"  readings {self.n}   reference x_m {self.reference:g}{unit}   "
-            f"tolerance T {self.tolerance:g}{unit}",
-            f"  mean {self.mean:.6g}{unit}   s {self.sd:.3g}{unit}   bias {self.bias:+.3g}{unit}",
+            f"  readings {self.n}   reference x_m {figure(self.reference)}   "
+            f"tolerance T {figure(self.tolerance, signed=False)}",
+            f"  mean {figure(self.mean)}   s {figure(self.sd, signed=False)}   "
+            f"bias {figure(self.bias)}",
             f"  Cg  = 0.2·T / (6·s)           = {index(self.cg)}   (capable at {CAPABLE_AT})",
             f"  Cgk = (0.1·T − |bias|) / (3·s) = {index(self.cgk)}   (capable at {CAPABLE_AT})",
         ]
@@ -148,12 +153,12 @@ class GaugeCheck:
                 f"  %Var(repeatability) {self.percent_repeatability:.1f} %   "
                 f"%Var(repeatability and bias) {'over 100' if both is None else f'{both:.1f}'} %"
             )
-        if self.resolution_ratio is None:
+        if self.resolution_ratio is None or self.resolution is None:
             lines.append("  resolution: not given (cannot say whether it is fine enough)")
         else:
             ok = "fine enough" if self.resolution_ok else "TOO COARSE (over 5 % of T)"
             lines.append(
-                f"  resolution {self.resolution:g}{unit} = "
+                f"  resolution {figure(self.resolution, signed=False)} = "
                 f"{100 * self.resolution_ratio:.1f} % of T: {ok}"
             )
         lines.extend(f"  note: {note}" for note in self.notes())

@@ -184,7 +184,8 @@ def channel_hints(
         tolerance = _figure(limits.usl - limits.lsl, resolution, unit).lstrip("+")
         hints.append(
             f"{name}: the tolerance {tolerance} spans "
-            f"only {steps:.3g} gauge steps of {resolution:g} (fewer than "
+            f"only {steps:.3g} gauge steps of {format_figure(resolution, resolution, signed=False)}"
+            " (fewer than "
             f"{RESOLUTION_RATIO:g}); the gauge is too coarse for this verdict: use a finer "
             "indicator."
         )

@@ -365,6 +365,7 @@ class LiveChannel:
             sigma,
             self.config.rule_set,
             unit=self.config.unit or None,
+            resolution=self.config.resolution,
             first_point=first,
             cycles=behind,
         )
@@ -409,10 +410,15 @@ class LiveChannel:
             frozen.point_sigma,
             self.config.rule_set,
             unit=self.config.unit or None,
+            resolution=self.config.resolution,
             cycles=self._point_labels(1),
         )
         ewma = ewma_alarms(
-            self._points, frozen, self._point_labels(1), unit=self.config.unit or None
+            self._points,
+            frozen,
+            self._point_labels(1),
+            unit=self.config.unit or None,
+            resolution=self.config.resolution,
         )
         # Carry the EWMA state on from the last point.
         self._ewma, self._ewma_run_start = ewma.state, ewma.run_start
@@ -431,6 +437,7 @@ class LiveChannel:
             frozen.point_sigma,
             self.config.rule_set,
             unit=self.config.unit or None,
+            resolution=self.config.resolution,
             first_point=first,
             cycles=self._point_labels(first),
         )
@@ -456,6 +463,7 @@ class LiveChannel:
                     half,
                     frozen,
                     self.config.unit or None,
+                    self.config.resolution,
                 )
             )
         else:

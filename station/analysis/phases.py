@@ -23,6 +23,7 @@ from station.analysis.constants import SIGMA_MULTIPLE
 from station.analysis.diagnostics import EWMA_LAMBDA, EWMA_WIDTH, ewma_values
 from station.analysis.rules import Alarm, check_rules, number_list
 from station.errors import StationError
+from station.text import format_figure
 
 #: Chart points after which the live limits freeze when the procedure names no minimum count.
 DEFAULT_FREEZE_AFTER = 20
@@ -46,7 +47,8 @@ class FrozenLimits:
                 raise StationError(f"the baseline's {name} {value!r} is not a finite number.")
         if not self.lcl < self.center < self.ucl:
             raise StationError(
-                f"baseline limits LCL {self.lcl:g} < centre {self.center:g} < UCL {self.ucl:g} "
+                f"baseline limits LCL {format_figure(self.lcl, None)} < centre "
+                f"{format_figure(self.center, None)} < UCL {format_figure(self.ucl, None)} "
                 "do not hold: give a centre line between the limits."
             )
 
@@ -91,15 +93,15 @@ def ewma_alarm(
     half_width: float,
     frozen: FrozenLimits,
     unit: str | None,
+    resolution: float | None = None,
 ) -> Alarm:
     """One EWMA alarm over consecutive flagged ``points`` (1-based)."""
     labels = tuple(sorted({int(c) for group in cycles for c in group}))
     above = value > frozen.center
     limit = frozen.center + (half_width if above else -half_width)
-    suffix = f" {unit}" if unit else ""
-    sigma = frozen.point_sigma
-    # One decimal beyond the sigma's first significant digit, as the run-rule sentences.
-    places = 4 if sigma <= 0 else max(0, min(12, 1 - math.floor(math.log10(sigma))))
+    # Written as every figure (one decimal beyond the gauge step), as the run-rule sentences.
+    ewma_text = format_figure(value, resolution, unit=unit or "")
+    limit_text = format_figure(limit, resolution, unit=unit or "")
     where = (
         f"{'Cycle' if len(labels) == 1 else 'Cycles'} {number_list(labels)}"
         if labels
@@ -108,8 +110,8 @@ def ewma_alarm(
     return Alarm(
         "ewma",
         tuple(points),
-        f"{where}: the EWMA ({value:+.{places}f}{suffix}) is {'above' if above else 'below'} "
-        f"its {'upper' if above else 'lower'} limit ({limit:+.{places}f}{suffix}): the mean is "
+        f"{where}: the EWMA ({ewma_text}) is {'above' if above else 'below'} "
+        f"its {'upper' if above else 'lower'} limit ({limit_text}): the mean is "
         f"drifting {'up' if above else 'down'}; let the robot warm up, look for a loose fixture or "
         "gauge, and repeat.",
         labels,
@@ -122,11 +124,13 @@ def ewma_alarms(
     cycles: Sequence[Sequence[int]],
     *,
     unit: str | None = None,
+    resolution: float | None = None,
     lam: float = EWMA_LAMBDA,
     width: float = EWMA_WIDTH,
 ) -> EwmaAlarms:
     """The EWMA of ``points`` about the frozen centre (z₀ = centre, σ the frozen point sigma):
-    one alarm per run of points beyond its limits."""
+    one alarm per run of points beyond its limits, its sentence written at the gauge
+    ``resolution``."""
     if not len(points):
         return EwmaAlarms((), None, None, 0)
     z = ewma_values(points, frozen.center, lam)
@@ -138,7 +142,13 @@ def ewma_alarms(
         for run in _runs(np.flatnonzero(flags)):
             last = run[-1] - 1
             alarm = ewma_alarm(
-                run, [cycles[p - 1] for p in run], float(z[last]), float(half[last]), frozen, unit
+                run,
+                [cycles[p - 1] for p in run],
+                float(z[last]),
+                float(half[last]),
+                frozen,
+                unit,
+                resolution,
             )
             found.append((run[0], alarm))
             if run[-1] == z.size:
@@ -165,13 +175,21 @@ def phase_two_alarms(
     cycles: Sequence[Sequence[int]],
     *,
     unit: str | None = None,
+    resolution: float | None = None,
 ) -> tuple[Alarm, ...]:
     """Every alarm of the points against frozen limits, run rules then the EWMA: the union of
     what the live analysis flags point by point once its limits are frozen."""
     rules = check_rules(
-        points, frozen.center, frozen.point_sigma, rule_set, unit=unit, cycles=cycles
+        points,
+        frozen.center,
+        frozen.point_sigma,
+        rule_set,
+        unit=unit,
+        resolution=resolution,
+        cycles=cycles,
     )
-    return tuple(rules) + ewma_alarms(points, frozen, cycles, unit=unit).alarms
+    ewma = ewma_alarms(points, frozen, cycles, unit=unit, resolution=resolution)
+    return tuple(rules) + ewma.alarms
 
 
 def baseline_to_json(baseline: ControlBaseline) -> dict[str, object]:

@@ -25,30 +25,11 @@ from station.analysis.rules import number_list, rule_name
 from station.analysis.spatial import Spatial
 from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis
 from station.analysis.verdict import Verdict, confidence_text, judge_verdict
+from station.text import format_figure, format_spread
 
 if TYPE_CHECKING:
     from station.analysis.accuracy import AccuracyAnalysis
     from station.analysis.linearity import LinearityAnalysis
-
-
-def decimals_for(resolution: float | None, spread: float | None) -> int:
-    """Decimals that show one digit beyond the gauge step, else three significant digits of
-    the spread (the report prints 5 decimals for a 0.0001 in indicator)."""
-    if resolution:
-        return min(10, max(0, 1 - math.floor(math.log10(resolution))))
-    if spread:
-        return min(10, max(0, 2 - math.floor(math.log10(abs(spread)))))
-    return 4
-
-
-def signed(value: float | None, decimals: int) -> str:
-    """A value with its sign and fixed decimals, or "-" when undefined."""
-    return "-" if value is None else f"{value:+.{decimals}f}"
-
-
-def unsigned(value: float | None, decimals: int) -> str:
-    """A non-negative figure (range, sigma) with fixed decimals, or "-" when undefined."""
-    return "-" if value is None else f"{value:.{decimals}f}"
 
 
 def index(value: float | None) -> str:
@@ -75,7 +56,7 @@ def _wrap(text: str, width: int, indent: str = "") -> list[str]:
 
 def format_readings(
     readings: Sequence[float],
-    decimals: int,
+    resolution: float | None,
     width: int = 80,
     cycles: Sequence[int] | None = None,
 ) -> list[str]:
@@ -85,7 +66,7 @@ def format_readings(
     pieces = list(range(1, n + 1)) if cycles is None else list(cycles)
     rows = math.ceil(n / 3)
     piece_width = max(5, max((len(str(p)) for p in pieces), default=1))
-    measure_width = max(11, max((len(signed(v, decimals)) for v in readings), default=0))
+    measure_width = max(11, max((len(format_figure(v, resolution)) for v in readings), default=0))
     pair = piece_width + 2 + measure_width
     gap = max(2, min(6, (width - 3 * pair) // 2))
     header = gap * " "
@@ -96,9 +77,8 @@ def format_readings(
         for column in range(3):
             i = column * rows + row
             if i < n:
-                cells.append(
-                    f"{pieces[i]:>{piece_width}}  {signed(readings[i], decimals):>{measure_width}}"
-                )
+                shown = format_figure(readings[i], resolution)
+                cells.append(f"{pieces[i]:>{piece_width}}  {shown:>{measure_width}}")
         lines.append(header.join(cells))
     return lines
 
@@ -106,7 +86,7 @@ def format_readings(
 def format_histogram(
     hist: Histogram,
     limits: SpecLimits | None,
-    decimals: int,
+    resolution: float | None,
     width: int = 80,
     nominal: float | None = None,
 ) -> list[str]:
@@ -115,7 +95,7 @@ def format_histogram(
     if not counts:
         return ["(no readings)"]
     centres = [(lo + hi) / 2 for lo, hi in zip(hist.edges[:-1], hist.edges[1:], strict=True)]
-    label_width = max(len(signed(c, decimals)) for c in centres)
+    label_width = max(len(format_figure(c, resolution)) for c in centres)
     count_width = len(str(max(counts)))
     marks: dict[int, list[str]] = {}
     last = len(counts) - 1
@@ -138,7 +118,7 @@ def format_histogram(
         bar = "#" * (0 if top == 0 else math.ceil(count * bar_room / top) if count else 0)
         mark = f" <{','.join(marks[i])}" if i in marks else ""
         lines.append(
-            f"{signed(centre, decimals):>{label_width}} |{bar.ljust(bar_room)} "
+            f"{format_figure(centre, resolution):>{label_width}} |{bar.ljust(bar_room)} "
             f"{count:>{count_width}}{mark}".rstrip()
         )
     if hist.below or hist.above:
@@ -156,21 +136,21 @@ def _interval(pair: tuple[float, float] | None) -> str:
 def _capability_lines(
     cap: Capability,
     chart_type: str,
-    decimals: int,
+    resolution: float | None,
     width: int,
     verdict: Verdict | None = None,
 ) -> list[str]:
     within_source = WITHIN_SIGMA_SOURCE.get(chart_type, "within subgroups")
     level = confidence_text(cap.confidence)
     lines = [
-        f"CAPABILITY (overall sigma {unsigned(cap.sigma, decimals)}: report §2.7.3's Cp/Cpk, "
-        "ISO 22514-2's Pp/Ppk)",
+        f"CAPABILITY (overall sigma {format_spread(cap.sigma, resolution)}: report §2.7.3's "
+        "Cp/Cpk, ISO 22514-2's Pp/Ppk)",
         f"  Cp {index(cap.cp)}   Cpu {index(cap.cpu)}   Cpl {index(cap.cpl)}   "
         f"Cpk {index(cap.cpk) if verdict is None or verdict.cpk is None else verdict.cpk_text}",
         f"  Cp (Pp)   {level} interval {_interval(cap.cp_ci)} (chi-square)",
         f"  Cpk (Ppk) {level} interval {_interval(cap.cpk_ci)}, one-sided bounds "
         f"{index(cap.cpk_lower)} and {index(cap.cpk_upper)} (Bissell)",
-        f"  Within sigma {unsigned(cap.sigma_within, decimals)} ({within_source}):",
+        f"  Within sigma {format_spread(cap.sigma_within, resolution)} ({within_source}):",
         f"    Cp within {index(cap.cp_within)}   Cpk within {index(cap.cpk_within)}",
     ]
     lines = [wrapped for line in lines for wrapped in _wrap(line, width)]
@@ -182,7 +162,9 @@ def _capability_lines(
     return lines
 
 
-def format_diagnostics(channel: ChannelAnalysis, decimals: int, width: int = 80) -> list[str]:
+def format_diagnostics(
+    channel: ChannelAnalysis, resolution: float | None, width: int = 80
+) -> list[str]:
     """Normality (and the percentile indices when it is rejected), lag-1 autocorrelation with
     the within- and overall-sigma indices side by side, and drift (trend and EWMA)."""
     lines: list[str] = []
@@ -215,9 +197,9 @@ def format_diagnostics(channel: ChannelAnalysis, decimals: int, width: int = 80)
     if percentile is not None:
         lines += _wrap(
             f"  The data are not normal: Cpk from sigma may mislead. {percentile.method}, "
-            f"quantiles 0.135% {signed(percentile.q_low, decimals)}, median "
-            f"{signed(percentile.median, decimals)}, "
-            f"99.865% {signed(percentile.q_high, decimals)}:",
+            f"quantiles 0.135% {format_figure(percentile.q_low, resolution)}, median "
+            f"{format_figure(percentile.median, resolution)}, "
+            f"99.865% {format_figure(percentile.q_high, resolution)}:",
             width,
         )
         word = (
@@ -246,9 +228,9 @@ def format_diagnostics(channel: ChannelAnalysis, decimals: int, width: int = 80)
                 cap = channel.capability
                 lines += _wrap(f"  {auto.message}.", width)
                 lines += _wrap(
-                    f"  Side by side: Cpk (overall sigma {unsigned(cap.sigma, decimals)}) "
+                    f"  Side by side: Cpk (overall sigma {format_spread(cap.sigma, resolution)}) "
                     f"{index(cap.cpk)}   Cpk within (sigma "
-                    f"{unsigned(cap.sigma_within, decimals)}) {index(cap.cpk_within)}",
+                    f"{format_spread(cap.sigma_within, resolution)}) {index(cap.cpk_within)}",
                     width,
                 )
     found = channel.drift
@@ -259,9 +241,9 @@ def format_diagnostics(channel: ChannelAnalysis, decimals: int, width: int = 80)
         else:
             basis = "reading times" if trend.basis == "time" else "cycle order"
             lines += _wrap(
-                f"DRIFT: trend on {basis} {signed(trend.per_span, decimals)} per "
-                f"{trend.span} cycles (95% CI {signed(trend.low, decimals)} to "
-                f"{signed(trend.high, decimals)}), {p_phrase(trend.p_value or 0.0)}",
+                f"DRIFT: trend on {basis} {format_figure(trend.per_span, resolution)} per "
+                f"{trend.span} cycles (95% CI {format_figure(trend.low, resolution)} to "
+                f"{format_figure(trend.high, resolution)}), {p_phrase(trend.p_value or 0.0)}",
                 width,
             )
         if found.ewma is not None:
@@ -283,23 +265,23 @@ def format_diagnostics(channel: ChannelAnalysis, decimals: int, width: int = 80)
 def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int = 80) -> list[str]:
     """The report block of one channel."""
     d, cap, chart = channel.descriptive, channel.capability, channel.chart
-    decimals = decimals_for(config.resolution, d.sd or d.range)
+    resolution = config.resolution
     limits = channel.limits
     n = d.n
     unit = f" ({config.unit})" if config.unit else ""
     lines = [f"FEATURE: {channel.name}{unit}   NO. PIECES: {n}", ""]
-    mode = " ".join(signed(m, decimals) for m in d.modes) or "-"
+    mode = " ".join(format_figure(m, resolution) for m in d.modes) or "-"
     lines += _pairs(
         [
-            ("MAXIMUM", signed(d.max, decimals)),
-            ("AVERAGE", signed(d.mean, decimals)),
-            ("MINIMUM", signed(d.min, decimals)),
-            ("UPPER SPEC", signed(None if limits is None else limits.usl, decimals)),
-            ("NOMINAL", signed(channel.nominal, decimals)),
-            ("LOWER SPEC", signed(None if limits is None else limits.lsl, decimals)),
+            ("MAXIMUM", format_figure(d.max, resolution)),
+            ("AVERAGE", format_figure(d.mean, resolution)),
+            ("MINIMUM", format_figure(d.min, resolution)),
+            ("UPPER SPEC", format_figure(None if limits is None else limits.usl, resolution)),
+            ("NOMINAL", format_figure(channel.nominal, resolution)),
+            ("LOWER SPEC", format_figure(None if limits is None else limits.lsl, resolution)),
             ("TOTAL NUMBER OF PIECES", str(n)),
-            ("SIGMA", unsigned(d.sd, decimals)),
-            ("RANGE", unsigned(d.range, decimals)),
+            ("SIGMA", format_spread(d.sd, resolution)),
+            ("RANGE", format_spread(d.range, resolution)),
         ],
         width,
     )
@@ -317,21 +299,22 @@ def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int 
             parts.append(f"above USL at cycles {number_list(found.cycles_above)}")
         lines += _wrap(f"OUT OF SPEC: {found.total} readings, " + "; ".join(parts), width)
     lines.append("")
-    lines += format_readings(channel.readings, decimals, width, channel.cycles or None)
+    lines += format_readings(channel.readings, resolution, width, channel.cycles or None)
     lines.append("")
-    lines.append(f"HISTOGRAM (bin width {channel.histogram.bin_width:g})")
-    lines += format_histogram(channel.histogram, limits, decimals, width, channel.nominal)
+    lines.append(f"HISTOGRAM (bin width {format_spread(channel.histogram.bin_width, resolution)})")
+    lines += format_histogram(channel.histogram, limits, resolution, width, channel.nominal)
     lines.append("")
     dispersion = {"I-MR": "MR", "Xbar-R": "R", "Xbar-S": "S"}.get(chart.type, "dispersion")
     location = "X" if chart.type == "I-MR" else "Xbar"
     lines.append(
         f"CONTROL CHART: {chart.type}, subgroup {chart.subgroup}, "
-        f"sigma within {unsigned(chart.sigma_within, decimals)}"
+        f"sigma within {format_spread(chart.sigma_within, resolution)}"
     )
     for label, limits_of in ((location, chart), (dispersion, chart.dispersion)):
         lines.append(
-            f"  {label + ' chart:':<11} UCL {signed(limits_of.ucl, decimals)}   "
-            f"CENTER {signed(limits_of.center, decimals)}   LCL {signed(limits_of.lcl, decimals)}"
+            f"  {label + ' chart:':<11} UCL {format_figure(limits_of.ucl, resolution)}   "
+            f"CENTER {format_figure(limits_of.center, resolution)}   "
+            f"LCL {format_figure(limits_of.lcl, resolution)}"
         )
     if chart.message:
         lines += _wrap(f"  {chart.message}", width)
@@ -349,8 +332,9 @@ def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int 
             source = f"baseline: {source}" if source else "baseline"
         lines += _wrap(
             f"LIVE LIMITS (phase II, {source}): "
-            f"UCL {signed(frozen.ucl, decimals)}   CENTER {signed(frozen.center, decimals)}   "
-            f"LCL {signed(frozen.lcl, decimals)}",
+            f"UCL {format_figure(frozen.ucl, resolution)}   "
+            f"CENTER {format_figure(frozen.center, resolution)}   "
+            f"LCL {format_figure(frozen.lcl, resolution)}",
             width,
         )
         if channel.live_alarms:
@@ -360,8 +344,8 @@ def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int 
         else:
             lines.append("LIVE ALARMS (against the frozen limits): none")
     lines.append("")
-    lines += _capability_lines(cap, chart.type, decimals, width, channel.verdict)
-    diagnostics = format_diagnostics(channel, decimals, width)
+    lines += _capability_lines(cap, chart.type, resolution, width, channel.verdict)
+    diagnostics = format_diagnostics(channel, resolution, width)
     if diagnostics:
         lines += ["", *diagnostics]
     return lines
@@ -369,10 +353,9 @@ def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int 
 
 def format_spatial(spatial: Spatial, config: AnalysisConfig, width: int = 80) -> list[str]:
     """The 3-D block: per-axis offsets, the report's total, ISO 9283 AP and RP."""
-    spread = spatial.l_sd or spatial.total_offset or None
-    decimals = decimals_for(config.resolution, spread)
+    resolution = config.resolution
     unit = f" {config.unit}" if config.unit else ""
-    cells = [signed(v, decimals) for v in spatial.offset.values()]
+    cells = [format_figure(v, resolution) for v in spatial.offset.values()]
     column = max(len(c) for c in cells) + 3
     lines = [
         f"3-D FIGURES (x, y, z; {spatial.n} cycles)",
@@ -380,13 +363,14 @@ def format_spatial(spatial: Spatial, config: AnalysisConfig, width: int = 80) ->
         "  " + "Offset (average - nominal)".ljust(26) + "".join(c.rjust(column) for c in cells),
         "  "
         + "Nominal".ljust(26)
-        + "".join(signed(v, decimals).rjust(column) for v in spatial.nominal.values()),
+        + "".join(format_figure(v, resolution).rjust(column) for v in spatial.nominal.values()),
         f"  Total offset sqrt(sum of squared offsets) = ISO 9283 APp: "
-        f"{unsigned(spatial.total_offset, decimals)}{unit}",
+        f"{format_spread(spatial.total_offset, resolution)}{unit}",
         "  ISO 9283 pose accuracy APx, APy, APz: the offsets above",
         f"  ISO 9283 pose repeatability RP = l-bar + 3 S_l: "
-        f"{unsigned(spatial.rp, decimals)}{unit} "
-        f"(l-bar {unsigned(spatial.l_mean, decimals)}, S_l {unsigned(spatial.l_sd, decimals)})",
+        f"{format_spread(spatial.rp, resolution)}{unit} "
+        f"(l-bar {format_spread(spatial.l_mean, resolution)}, "
+        f"S_l {format_spread(spatial.l_sd, resolution)})",
     ]
     if spatial.message:
         lines.append(f"  {spatial.message}")
@@ -409,9 +393,14 @@ def format_report(
     config = analysis.config
     rule = "=" * width
     lines = _wrap(title, width) + [rule]
+    # The gauge step in the one number format too (never 1e-05).
+    step = (
+        "not given"
+        if not config.resolution
+        else format_spread(config.resolution, config.resolution)
+    )
     lines.append(
-        f"Unit: {config.unit or 'not given'}   Resolution: {config.resolution or 'not given'}   "
-        f"Subgroup: {config.subgroup}"
+        f"Unit: {config.unit or 'not given'}   Resolution: {step}   Subgroup: {config.subgroup}"
     )
     lines += _wrap(
         f"Run rules: {config.rule_set}   Capable when Cpk >= {config.threshold:g}   "
@@ -459,11 +448,12 @@ def format_linearity(
     straightness (chart, alarms, capability) is a channel block of its own
     (:func:`format_channel` of :func:`~station.analysis.linearity.linearity_summary`)."""
     channels = result.channels
-    spread = max((result.mz[c] for c in channels), default=0.0) or None
-    decimals = decimals_for(config.resolution, spread)
+    resolution = config.resolution
     unit = f" {config.unit}" if config.unit else ""
     tolerance = (
-        "not given" if result.tolerance is None else f"{unsigned(result.tolerance, decimals)}{unit}"
+        "not given"
+        if result.tolerance is None
+        else f"{format_spread(result.tolerance, resolution)}{unit}"
     )
     lines = _wrap(
         f"LINEARITY (report §2.9; {len(result.strokes)} strokes; straightness tolerance "
@@ -483,7 +473,7 @@ def format_linearity(
     rows = [
         [str(r.number), r.direction, str(r.points)]
         + [
-            unsigned(getattr(r.straightness[c], kind), decimals)
+            format_spread(getattr(r.straightness[c], kind), resolution)
             for c in channels
             for kind in ("ls", "mz")
         ]
@@ -494,7 +484,7 @@ def format_linearity(
     rows = [
         [d.direction, str(d.strokes)]
         + [
-            f"{unsigned(d.mz_max[c], decimals)} / {unsigned(d.mz_mean[c], decimals)}"
+            f"{format_spread(d.mz_max[c], resolution)} / {format_spread(d.mz_mean[c], resolution)}"
             for c in channels
         ]
         for d in result.directions.values()
@@ -504,11 +494,12 @@ def format_linearity(
     lines.append("")
     for c in channels:
         path = result.path[c]
-        at = "" if path.at is None else f" at s = {unsigned(path.at, decimals)}"
+        at = "" if path.at is None else f" at s = {format_spread(path.at, resolution)}"
         lines += _wrap(
-            f"{c}: largest straightness LS {unsigned(result.ls[c], decimals)}, MZ "
-            f"{unsigned(result.mz[c], decimals)}{unit}; path repeatability (largest 3s along "
-            f"the bar over {path.strokes} strokes) {unsigned(path.max_3s, decimals)}{unit}{at}",
+            f"{c}: largest straightness LS {format_spread(result.ls[c], resolution)}, MZ "
+            f"{format_spread(result.mz[c], resolution)}{unit}; path repeatability (largest 3s "
+            f"along the bar over {path.strokes} strokes) "
+            f"{format_spread(path.max_3s, resolution)}{unit}{at}",
             width,
         )
     lines += _wrap(
@@ -523,8 +514,7 @@ def format_accuracy(result: AccuracyAnalysis, config: AnalysisConfig, width: int
     """The relative-accuracy block (§2.8): per placement the pendant coordinates, the distance
     moved and the mean error per axis and in 3-D; across placements the average accuracy per
     axis, its spread, and the error per unit moved."""
-    spread = max(abs(v) for p in result.placements for v in p.mean.values()) or None
-    decimals = decimals_for(config.resolution, spread)
+    resolution = config.resolution
     unit = f" {config.unit}" if config.unit else ""
     lines = _wrap(
         f"RELATIVE ACCURACY (report §2.8; {len(result.placements)} placements, "
@@ -548,8 +538,8 @@ def format_accuracy(result: AccuracyAnalysis, config: AnalysisConfig, width: int
     lines += _table(["PLACE", "N", "X", "Y", "Z", "DISTANCE"], rows, width)
     rows = [
         [str(p.number)]
-        + [signed(p.mean[axis], decimals) for axis in ("x", "y", "z")]
-        + [unsigned(p.error_3d, decimals)]
+        + [format_figure(p.mean[axis], resolution) for axis in ("x", "y", "z")]
+        + [format_spread(p.error_3d, resolution)]
         for p in result.placements
     ]
     lines += ["", "MEAN ERROR PER PLACEMENT (x, y, z and the 3-D error sqrt(x^2 + y^2 + z^2))"]
@@ -558,9 +548,9 @@ def format_accuracy(result: AccuracyAnalysis, config: AnalysisConfig, width: int
     rows = [
         [
             axis,
-            signed(result.average[axis], decimals),
-            unsigned(result.spread[axis], decimals),
-            unsigned(result.span[axis], decimals),
+            format_figure(result.average[axis], resolution),
+            format_spread(result.spread[axis], resolution),
+            format_spread(result.span[axis], resolution),
             # Parts per million of the distance moved: plain decimals, never 1e-05 notation.
             "-" if result.scale_error is None else f"{result.scale_error[axis] * 1e6:+.1f}",
         ]
@@ -569,8 +559,8 @@ def format_accuracy(result: AccuracyAnalysis, config: AnalysisConfig, width: int
     lines += _table(["AXIS", "AVERAGE", "SIGMA", "RANGE", "ERROR PER MOVE (ppm)"], rows, width)
     d = result.error_3d.descriptive
     lines += _wrap(
-        f"3-D error sqrt(x^2 + y^2 + z^2) per reading: mean {unsigned(d.mean, decimals)}, "
-        f"sigma {unsigned(d.sd, decimals)}, max {unsigned(d.max, decimals)}{unit}",
+        f"3-D error sqrt(x^2 + y^2 + z^2) per reading: mean {format_spread(d.mean, resolution)}, "
+        f"sigma {format_spread(d.sd, resolution)}, max {format_spread(d.max, resolution)}{unit}",
         width,
     )
     if result.per_unit is None:

@@ -43,6 +43,7 @@ import numpy as np
 
 from station.analysis.descriptive import as_readings
 from station.errors import StationError
+from station.text import format_figure
 
 RULE_SETS: tuple[str, ...] = ("report", "western-electric", "nelson")
 
@@ -376,11 +377,11 @@ def rule_descriptions(rule_set: str) -> list[tuple[str, str]]:
     return [(rule_id, kind.description) for rule_id, kind in _rules_of(rule_set)]
 
 
-def _formatter(sigma: float, unit: str | None) -> Formatter:
-    """Numbers to one decimal beyond the sigma's first significant digit, with the unit."""
-    decimals = 4 if sigma <= 0 else max(0, min(12, 1 - math.floor(math.log10(sigma))))
-    suffix = f" {unit}" if unit else ""
-    return lambda value: f"{value:.{decimals}f}{suffix}"
+def _formatter(resolution: float | None, unit: str | None) -> Formatter:
+    """A control line in the alarm's sentence as every figure is written
+    (:func:`~station.text.format_figure`: signed, one decimal beyond the gauge step), with the
+    unit."""
+    return lambda value: format_figure(value, resolution, unit=unit or "")
 
 
 def _subject(points: list[int]) -> str:
@@ -431,6 +432,7 @@ def check_rules(
     rule_set: str = "report",
     *,
     unit: str | None = None,
+    resolution: float | None = None,
     first_point: int = 1,
     cycles: Sequence[Sequence[int]] | None = None,
 ) -> list[Alarm]:
@@ -438,7 +440,8 @@ def check_rules(
 
     ``sigma`` is the sigma of the plotted statistic, (UCL - centre) / 3 (see
     ``ControlChart.point_sigma``). With no centre or sigma (a chart without limits) there is
-    nothing to check and the list is empty. ``unit`` is appended to the values in the text.
+    nothing to check and the list is empty. The control lines in the text are written at the
+    gauge ``resolution`` (one decimal beyond its step) with ``unit`` after them.
     ``first_point`` is the chart number of ``points[0]``: the live form checks only the last
     window of a long chart and still names the points as the chart numbers them.
     ``cycles`` gives, for each of ``points`` in order, the cycle numbers behind it (one for
@@ -460,7 +463,7 @@ def check_rules(
             "sigma must be a finite number >= 0"
         )
     ctx = _Context(values, float(center), float(sigma))
-    fmt = _formatter(float(sigma), unit)
+    fmt = _formatter(resolution, unit)
     found: list[tuple[int, int, Alarm]] = []
     for order, (rule_id, kind) in enumerate(rules):
         for side, flags in kind.check(ctx).items():

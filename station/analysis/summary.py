@@ -141,8 +141,9 @@ class ChannelAnalysis:
     drift: Drift | None = None
     frozen: FrozenLimits | None = None
     """The phase II limits the live alarms are judged against (None: too few points yet)."""
-    phase_rules: tuple[str, str, int] = ("report", "", 1)
-    """Rule set, unit and subgroup size the live alarms are judged with."""
+    phase_rules: tuple[str, str, int, float | None] = ("report", "", 1, None)
+    """Rule set, unit, subgroup size and gauge resolution the live alarms are judged (and
+    worded) with."""
     times: tuple[float, ...] = ()
 
     @cached_property
@@ -151,7 +152,7 @@ class ChannelAnalysis:
         first use: against limits frozen early a long drifting record raises very many."""
         if self.frozen is None:
             return ()
-        rule_set, unit, size = self.phase_rules
+        rule_set, unit, size, resolution = self.phase_rules
         values = np.asarray(self.readings, dtype=float)
         complete = len(values) // size
         if not complete:
@@ -164,6 +165,7 @@ class ChannelAnalysis:
             rule_set,
             point_cycles(self.cycles, size, complete),
             unit=unit or None,
+            resolution=resolution,
         )
 
     @cached_property
@@ -300,7 +302,11 @@ def cycle_labels(name: str, cycles: Sequence[int] | None, n: int) -> tuple[int, 
 
 
 def chart_alarms(
-    chart: ControlChart, rule_set: str, unit: str = "", cycles: Sequence[int] | None = None
+    chart: ControlChart,
+    rule_set: str,
+    unit: str = "",
+    cycles: Sequence[int] | None = None,
+    resolution: float | None = None,
 ) -> tuple[Alarm, ...]:
     """The run-rule alarms of a chart's location points, labelled by ``cycles`` (the cycle
     number of each reading; 1, 2, 3 ... when None).
@@ -320,6 +326,7 @@ def chart_alarms(
             sigma,
             rule_set,
             unit=unit or None,
+            resolution=resolution,
             cycles=point_cycles(cycles, chart.subgroup, len(chart.points)),
         )
     )
@@ -399,7 +406,7 @@ def analyze_channel(
         histogram=hist,
         capability=cap,
         chart=chart,
-        alarms=chart_alarms(chart, config.rule_set, config.unit, labels),
+        alarms=chart_alarms(chart, config.rule_set, config.unit, labels, config.resolution),
         readings=tuple(values.tolist()),
         limits=limits,
         nominal=config.nominal_for(name),
@@ -418,7 +425,7 @@ def analyze_channel(
             resolution=config.resolution,
         ),
         frozen=frozen,
-        phase_rules=(config.rule_set, config.unit, config.subgroup),
+        phase_rules=(config.rule_set, config.unit, config.subgroup, config.resolution),
         times=clock or (),
     )
 

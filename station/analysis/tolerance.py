@@ -7,6 +7,8 @@ gauge reads as ±25 in (issue 13). Both ask the operator to confirm, naming the 
 
 from __future__ import annotations
 
+from station.text import format_spread
+
 FEWEST_STEPS = 10.0
 MOST_STEPS = 100_000.0
 
@@ -44,12 +46,14 @@ def implausible_tolerance(
         return None
     if steps < FEWEST_STEPS:
         return (
-            f"{channel}: the tolerance spans only {steps:,.3g} gauge steps of {resolution:g} "
-            f"{unit} (under {FEWEST_STEPS:g}): the gauge is too coarse for a verdict."
+            f"{channel}: the tolerance spans only {steps:,.3g} gauge steps of "
+            f"{format_spread(resolution, resolution, unit=unit)} (under {FEWEST_STEPS:g}): the "
+            "gauge is too coarse for a verdict."
         )
     if steps > MOST_STEPS:
         return (
-            f"{channel}: the tolerance spans {steps:,.0f} gauge steps of {resolution:g} {unit} "
+            f"{channel}: the tolerance spans {steps:,.0f} gauge steps of "
+            f"{format_spread(resolution, resolution, unit=unit)} "
             f"(over {MOST_STEPS:,.0f}): is the limit in {unit}, and not a slip?"
         )
     return None

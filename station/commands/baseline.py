@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from station.errors import StationError
+from station.text import format_figure
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -76,8 +77,15 @@ def run(args: argparse.Namespace) -> int:
             f"baseline of {plain(robot)}: session {record['session']} ({plain(record['file'])}), "
             f"created {record['date']}, anchor {record['anchor']}"
         )
+    recorded = record.get("resolution")
+    # A baseline filed before it recorded its gauge step: the figures at six decimals.
+    resolution = float(recorded) if isinstance(recorded, int | float) and recorded > 0 else None
     for channel, spec in record["channels"].items():
-        shown = {k: "—" if spec[k] is None else f"{spec[k]:+.6g}" for k in spec}
+        # The control lines are positions (signed), the moving range's limit a spread.
+        shown = {
+            k: "—" if spec[k] is None else format_figure(spec[k], resolution, signed=k != "mr_ucl")
+            for k in spec
+        }
         print(
             f"  {plain(channel)}: centre {shown['center']}  LCL {shown['lcl']}  "
             f"UCL {shown['ucl']}  MR UCL {shown['mr_ucl']}"

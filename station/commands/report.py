@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from station.commands._parser import output_name
+from station.errors import StationError
 
 FORMATS = ("txt", "md", "html")
 
@@ -33,7 +34,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--output",
         metavar="OUT",
         type=output_name,
-        help="write to OUT instead of standard output",
+        help="write to OUT instead of standard output (html needs it at a terminal)",
     )
     parser.add_argument("--force", action="store_true", help="overwrite OUT when it exists")
     parser.set_defaults(func=run)
@@ -56,6 +57,13 @@ def run(args: argparse.Namespace) -> int:
     fmt = output_format(args.format, args.output)
     source = Path(args.file)
     if not args.output:
+        if fmt == "html" and sys.stdout.isatty():
+            # A page of inline SVG charts (some 170 KB) is no text to read at a terminal; a
+            # pipe or a redirect still gets it.
+            raise StationError(
+                "an HTML report is a page for a browser, not for the terminal: "
+                f"write it to a file with -o {source.with_suffix('.html').name}"
+            )
         sys.stdout.write(render_report(source, fmt))
         return 0
     out = Path(args.output)

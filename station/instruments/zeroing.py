@@ -21,6 +21,7 @@ from typing import Any, Literal
 
 from station.errors import StationError
 from station.instruments.protocols.common import decimals_for
+from station.text import format_spread
 
 ZeroMethod = Literal["device", "software"]
 
@@ -159,11 +160,11 @@ def moving_message(
     moving: Sequence[tuple[str, float, float]], still: float, window: float | None, unit: str
 ) -> str:
     """The refusal for channels that move: ``(channel, spread, resolution)`` each."""
-    suffix = f" {unit}" if unit else ""
     over = f" over {window:.1f} s" if window else ""
+    # The spread and the gauge step in the one number format (never 1e-05), as every figure.
     parts = [
-        f"{channel} moves (its readings spread {spread:g}{suffix}{over}, more than "
-        f"{still:g} × {res:g})"
+        f"{channel} moves (its readings spread {format_spread(spread, res, unit=unit)}{over}, "
+        f"more than {still:g} × {format_spread(res, res)})"
         for channel, spread, res in moving
     ]
     return (

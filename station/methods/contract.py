@@ -224,6 +224,15 @@ class ChartKit(Protocol):
         """Text from outside (a channel name, a unit) as a chart may show it."""
         ...
 
+    def number(self, value: float, *, signed: bool = True) -> str:
+        """A figure in the session's unit in the one number format (one decimal beyond the
+        gauge step: :func:`station.text.format_figure`)."""
+        ...
+
+    def legend(self, axes: Any) -> None:
+        """The axes' legend, outside the plot (never over the data)."""
+        ...
+
 
 # -- the demo ---------------------------------------------------------------------------------
 

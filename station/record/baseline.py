@@ -100,6 +100,8 @@ def make_baseline(analysed: AnalysedSession) -> dict[str, Any]:
         "procedure": {k: procedure.get(k) for k in ("id", "version", "sha256")},
         "kind": analysed.kind,
         "unit": session.unit,
+        # The gauge step the limits are written at (one decimal beyond it, as every figure).
+        "resolution": session.header.get("resolution"),
         "chart": analysis.channels[next(iter(analysis.channels))].chart.type,
         "channels": channels,
     }

@@ -28,6 +28,7 @@ from station.methods import Judgement
 from station.plain import plain
 from station.record.content import parse_time
 from station.record.source import AnalysedSession
+from station.text import format_figure
 
 if TYPE_CHECKING:
     # The type only: this module loads matplotlib when it draws.
@@ -86,33 +87,100 @@ def _figure(width: float = 7.0, height: float = 3.2) -> Any:
     return Figure(figsize=(width, height), layout="constrained")
 
 
-def histogram_chart(name: str, channel: Any, unit: str) -> Any:
-    """The readings' histogram with LSL, USL, nominal and the mean marked."""
+def _figure_ticks(axis: Any, resolution: float | None) -> None:
+    """An axis of figures in the session's unit labelled in the one number format."""
+    from matplotlib.ticker import FuncFormatter
+
+    axis.set_major_formatter(FuncFormatter(lambda value, _: format_figure(value, resolution)))
+
+
+def _legend_outside(axes: Any) -> None:
+    """The legend to the right of the plot, never over a bar or a point."""
+    axes.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, fontsize=7)
+
+
+def bin_id(key: str, centre: str, count: int) -> str:
+    """The SVG id of a histogram bar (``histogram-x:+0.00010:4``): the channel (its key with
+    anything but letters, digits, ``_`` and ``-`` made ``_``, cut to
+    :data:`CHART_TEXT_LIMIT`: a name from outside is no markup), the gauge value the bar is
+    centred on and its count, so the drawn counts can be checked against the text report's."""
+    return f"histogram-{_SAFE_KEY.sub('_', key)[:CHART_TEXT_LIMIT]}:{centre}:{count}"
+
+
+def histogram_chart(
+    name: str, channel: Any, unit: str, resolution: float | None = None, key: str = ""
+) -> Any:
+    """The readings' histogram against LSL and USL, with the nominal, the mean and the mode
+    marked: the analysis' own bins (those of the text report), each centred on a gauge value
+    with its edges midway to the next, so two neighbouring gauge values never share a bar and
+    the tallest bar is the data's mode. Each bar is labelled with its count."""
     name, unit = chart_text(name), chart_text(unit)
     figure = _figure()
     axes = figure.add_subplot()
-    values = np.asarray(channel.readings, dtype=float)
-    bins = min(30, max(5, int(np.sqrt(values.size)) + 1))
-    axes.hist(values, bins=bins, color=POINT_COLOUR, alpha=0.75, edgecolor="white")
+    hist = channel.histogram
+    edges = np.asarray(hist.edges, dtype=float)
+    centres = (edges[:-1] + edges[1:]) / 2
+    bars = axes.bar(
+        centres,
+        hist.counts,
+        width=hist.bin_width * 0.9,
+        color=POINT_COLOUR,
+        alpha=0.75,
+        edgecolor="white",
+    )
+    for bar, centre, count in zip(bars, centres, hist.counts, strict=True):
+        bar.set_gid(bin_id(key, format_figure(float(centre), resolution), int(count)))
+    axes.bar_label(bars, labels=[str(c) if c else "" for c in hist.counts], fontsize=7)
     limits = channel.limits
     if limits is not None:
         for value, label in ((limits.lsl, "LSL"), (limits.usl, "USL")):
             if value is not None:
-                axes.axvline(value, color=LIMIT_COLOUR, linestyle="--", label=f"{label} {value:g}")
+                shown = format_figure(value, resolution)
+                axes.axvline(value, color=LIMIT_COLOUR, linestyle="--", label=f"{label} {shown}")
     axes.axvline(channel.nominal, color="grey", linestyle=":", label="nominal")
-    axes.axvline(channel.descriptive.mean, color=CENTRE_COLOUR, label="mean")
+    mean = channel.descriptive.mean
+    axes.axvline(mean, color=CENTRE_COLOUR, label=f"mean {format_figure(mean, resolution)}")
+    for number, mode in enumerate(channel.descriptive.modes):
+        axes.axvline(
+            mode,
+            color=ALARM_COLOUR,
+            linestyle="-.",
+            linewidth=1,
+            label=f"mode {format_figure(mode, resolution)}" if number == 0 else None,
+        )
     axes.set_title(f"Histogram of {name} against the limits")
     axes.set_xlabel(f"reading ({unit})" if unit else "reading")
     axes.set_ylabel("count")
-    axes.legend(loc="upper right", fontsize=7)
+    axes.margins(y=0.12)  # room for the counts above the tallest bar
+    _figure_ticks(axes.xaxis, resolution)
+    axes.tick_params(axis="x", labelrotation=30, labelsize=7)
+    _legend_outside(axes)
     return figure
 
 
-def control_chart(name: str, channel: Any, xlabel: str = "cycle") -> Any:
-    """The location chart: points by cycle (or stroke), centre line, control limits, alarms
-    circled in red."""
+def judged_limits(channel: Any) -> tuple[Any, tuple[Any, ...], str]:
+    """The control lines a channel's drawn alarms were judged against, those alarms, and what
+    the lines are: once the live limits froze (after the first points, or a robot's baseline),
+    the frozen limits and the live alarms (those the report lists); before that, the limits
+    of all the points (retrospective) and their alarms."""
+    frozen = channel.frozen
+    if frozen is not None:
+        source = frozen.source or "frozen"
+        if not source.startswith("frozen"):
+            source = f"baseline: {source}" if not source.startswith("baseline") else source
+        return frozen, tuple(channel.live_alarms), f"live limits, {source}"
+    return channel.chart, tuple(channel.alarms), "retrospective limits (all points)"
+
+
+def control_chart(
+    name: str, channel: Any, xlabel: str = "cycle", resolution: float | None = None
+) -> Any:
+    """The location chart: points by cycle (or stroke), the centre line and control limits its
+    alarms were judged against (:func:`judged_limits`, named in the title and the legend),
+    those alarms circled in red."""
     chart = channel.chart
     name = chart_text(name)
+    lines, alarms, judged = judged_limits(channel)
     figure = _figure()
     axes = figure.add_subplot()
     points = np.asarray(chart.points, dtype=float)
@@ -121,14 +189,16 @@ def control_chart(name: str, channel: Any, xlabel: str = "cycle") -> Any:
     x = np.asarray([labels[min(i * subgroup, len(labels) - 1)] for i in range(points.size)])
     axes.plot(x, points, marker="o", markersize=3, color=POINT_COLOUR, linewidth=1)
     for value, label, style in (
-        (chart.center, "CL", "-"),
-        (chart.ucl, "UCL", "--"),
-        (chart.lcl, "LCL", "--"),
+        (lines.center, "CL", "-"),
+        (lines.ucl, "UCL", "--"),
+        (lines.lcl, "LCL", "--"),
     ):
         if value is not None:
             colour = CENTRE_COLOUR if label == "CL" else LIMIT_COLOUR
-            axes.axhline(value, color=colour, linestyle=style, linewidth=1, label=label)
-    flagged = sorted({p for alarm in channel.alarms for p in alarm.points if 0 <= p < points.size})
+            shown = f"{label} {format_figure(value, resolution)}"
+            axes.axhline(value, color=colour, linestyle=style, linewidth=1, label=shown)
+    # Alarm points are 1-based positions on the chart.
+    flagged = sorted({p - 1 for alarm in alarms for p in alarm.points if 1 <= p <= points.size})
     if flagged:
         axes.scatter(
             x[flagged],
@@ -137,12 +207,13 @@ def control_chart(name: str, channel: Any, xlabel: str = "cycle") -> Any:
             facecolors="none",
             edgecolors=ALARM_COLOUR,
             linewidths=1.5,
-            label=f"alarm ({len(channel.alarms)})",
+            label=f"alarm ({len(alarms)})",
             zorder=3,
         )
-    axes.set_title(f"Control chart ({chart.type}) of {name}")
+    axes.set_title(f"Control chart ({chart.type}) of {name}: {judged}", fontsize=8)
     axes.set_xlabel(xlabel)
-    axes.legend(loc="upper right", fontsize=7)
+    _figure_ticks(axes.yaxis, resolution)
+    _legend_outside(axes)
     return figure
 
 
@@ -166,11 +237,13 @@ def offsets_chart(analysis: Any, unit: str) -> Any:
     axes.set_ylabel("y" + suffix)
     axes.set_zlabel("z" + suffix)
     axes.set_title("3-D offsets from nominal")
-    axes.legend(loc="upper left", fontsize=7)
+    _legend_outside(axes)
     return figure
 
 
-def drift_chart(analysed: AnalysedSession, unit: str) -> Any | None:
+def drift_chart(
+    analysed: AnalysedSession, unit: str, resolution: float | None = None
+) -> Any | None:
     """Each channel's accepted readings against the time since the first (seconds, minutes or
     hours, as the session's length suits), with its least-squares trend; None with fewer than
     three timed cycles."""
@@ -209,12 +282,13 @@ def drift_chart(analysed: AnalysedSession, unit: str) -> Any | None:
                 intercept + slope * elapsed,
                 color=line.get_color(),
                 linestyle="--",
-                label=f"{channel} trend {slope:+.3g} {unit}/{label}".replace("  ", " "),
+                label=f"{channel} trend {format_figure(slope, resolution, unit=unit)}/{label}",
             )
     axes.set_title("Readings over time (drift)")
     axes.set_xlabel(f"time since the first cycle ({label})")
     axes.set_ylabel(f"reading ({unit})" if unit else "reading")
-    axes.legend(loc="upper right", fontsize=7)
+    _figure_ticks(axes.yaxis, resolution)
+    _legend_outside(axes)
     return figure
 
 
@@ -227,6 +301,8 @@ class _Kit:
     centre: str = CENTRE_COLOUR
     limit: str = LIMIT_COLOUR
     alarm: str = ALARM_COLOUR
+    resolution: float | None = None
+    """The session's gauge step, which :meth:`number` writes figures one decimal beyond."""
 
     def figure(self, width: float = 7.0, height: float = 3.2) -> Any:
         """A new figure of that size (inches)."""
@@ -236,6 +312,14 @@ class _Kit:
         """Text from outside as a chart shows it (:func:`chart_text`)."""
         return chart_text(text)
 
+    def number(self, value: float, *, signed: bool = True) -> str:
+        """A figure in the one number format (:func:`~station.text.format_figure`)."""
+        return format_figure(value, self.resolution, signed=signed)
+
+    def legend(self, axes: Any) -> None:
+        """The legend outside the plot (:func:`_legend_outside`)."""
+        _legend_outside(axes)
+
 
 def _figures(analysed: AnalysedSession) -> Iterator[tuple[str, str, Any]]:
     report = analysed.report
@@ -243,27 +327,29 @@ def _figures(analysed: AnalysedSession) -> Iterator[tuple[str, str, Any]]:
         return
     if report.inputs is not None:
         judgement = Judgement(report.analysis, report.result, report.sections, report.verdict)
-        yield from report.method.charts(report.inputs, judgement, _Kit())
+        recorded = analysed.session.header.get("resolution")
+        step = float(recorded) if isinstance(recorded, int | float) and recorded > 0 else None
+        yield from report.method.charts(report.inputs, judgement, _Kit(resolution=step))
     analysis = report.analysis
     if analysis is None:
         return
-    unit = analysis.config.unit
+    unit, resolution = analysis.config.unit, analysis.config.resolution
     for key, channel in analysis.channels.items():
         yield (
             f"histogram-{key}",
             f"Histogram of {chart_text(channel.name)}",
-            histogram_chart(channel.name, channel, unit),
+            histogram_chart(channel.name, channel, unit, resolution, str(key)),
         )
         if channel.chart.points:
             yield (
                 f"control-{key}",
                 f"Control chart of {chart_text(channel.name)}",
-                control_chart(channel.name, channel),
+                control_chart(channel.name, channel, resolution=resolution),
             )
     if analysis.spatial is not None:
         yield "offsets-3d", "3-D offsets", offsets_chart(analysis, unit)
     if report.method.drift_chart:
-        drift = drift_chart(analysed, unit)
+        drift = drift_chart(analysed, unit, resolution)
         if drift is not None:
             yield "drift", "Readings over time (drift)", drift
 

@@ -27,8 +27,8 @@ import numpy as np
 
 from station.analysis.summary import Analysis
 from station.errors import StationError
-from station.record.content import decimals_for
 from station.record.source import AnalysedSession, analyse_session
+from station.text import format_figure, format_index, format_spread
 
 
 @dataclass(frozen=True)
@@ -114,12 +114,12 @@ def compare_axis(
     unit: str = "",
     shifted: bool | None = None,
     spread_changed: bool | None = None,
-    places: int = 6,
+    resolution: float | None = None,
 ) -> AxisComparison:
     """Compare one channel's readings ``a`` (before) and ``b`` (after). ``shifted`` and
     ``spread_changed`` are the decisions (Holm's, from :func:`compare_sessions`); None decides
-    on this axis alone at 1 − ``confidence``. ``places``: decimals of the shifts in the
-    sentence."""
+    on this axis alone at 1 − ``confidence``. ``resolution``: the gauge step the sentence
+    writes the shifts at (:func:`~station.text.format_figure`)."""
     from scipy import stats  # on first use: see README, Development
 
     x = np.asarray(a, dtype=float)
@@ -153,18 +153,19 @@ def compare_axis(
         levene_p = 1.0
     moved = p <= alpha if shifted is None else shifted
     spread = levene_p <= alpha if spread_changed is None else spread_changed
-    suffix = f" {unit}" if unit else ""
     level = f"{confidence:.0%}"
+    moved_by = format_figure(shift, resolution, unit=unit)
+    from_text = format_figure(shift - margin, resolution)
+    to_text = format_figure(shift + margin, resolution)
     if moved:
-        from_text, to_text = f"{shift - margin:+.{places}f}", f"{shift + margin:+.{places}f}"
         first = (
-            f"{channel} moved {shift:+.{places}f}{suffix} ({level} CI {from_text} to {to_text}), "
+            f"{channel} moved {moved_by} ({level} CI {from_text} to {to_text}), "
             f"{_p_text(p)}: the change between the sessions moved {channel}"
         )
     else:
         first = (
-            f"{channel} did not move detectably ({shift:+.{places}f}{suffix}, {level} CI "
-            f"{shift - margin:+.{places}f} to {shift + margin:+.{places}f}, {_p_text(p)})"
+            f"{channel} did not move detectably ({moved_by}, {level} CI "
+            f"{from_text} to {to_text}, {_p_text(p)})"
         )
     if not math.isfinite(ratio):
         second = "spread not comparable (a session without spread)"
@@ -240,13 +241,13 @@ def compare_channels(
     *,
     confidence: float = 0.95,
     unit: str = "",
-    places: int = 6,
+    resolution: float | None = None,
 ) -> tuple[AxisComparison, ...]:
     """Compare every channel ``a`` and ``b`` share (in ``a``'s order), Holm's procedure holding
     the family-wise error rate at 1 − ``confidence`` for the shifts and for the spreads."""
     channels = [c for c in a if c in b]
     first = [
-        compare_axis(c, a[c], b[c], confidence=confidence, unit=unit, places=places)
+        compare_axis(c, a[c], b[c], confidence=confidence, unit=unit, resolution=resolution)
         for c in channels
     ]
     alpha = 1 - confidence
@@ -261,7 +262,7 @@ def compare_channels(
             unit=unit,
             shifted=shifted[i],
             spread_changed=spread[i],
-            places=places,
+            resolution=resolution,
         )
         for i, c in enumerate(channels)
     )
@@ -297,10 +298,10 @@ def compare_sessions(
     readings_b = {name: c.readings for name, c in analysis_b.channels.items()}
     if not set(readings_a) & set(readings_b):
         raise StationError(f"{sa.path.name} and {sb.path.name} share no channel to compare.")
-    resolution = sa.header.get("resolution")
-    places = decimals_for(resolution if isinstance(resolution, int | float) else None)
+    recorded = sa.header.get("resolution")
+    resolution = float(recorded) if isinstance(recorded, int | float) else None
     axes = compare_channels(
-        readings_a, readings_b, confidence=confidence, unit=sa.unit, places=places
+        readings_a, readings_b, confidence=confidence, unit=sa.unit, resolution=resolution
     )
     hotelling = None
     names = [n for n in ("x", "y", "z") if n in readings_a and n in readings_b]
@@ -317,15 +318,17 @@ def compare_sessions(
     unit = sa.unit
     if hotelling is not None:
         verdict = "moved" if hotelling.p <= 1 - confidence else "did not move detectably"
+        length = format_spread(hotelling.length, resolution, unit=unit)
         sentences.append(
-            f"The 3-D mean {verdict}: shift {hotelling.length:.{places}f} {unit}, Hotelling T² "
-            f"{hotelling.t2:.3g} (F {hotelling.f:.3g} on {hotelling.df1} and {hotelling.df2} "
+            f"The 3-D mean {verdict}: shift {length}, Hotelling T² {format_index(hotelling.t2)} "
+            f"(F {format_index(hotelling.f)} on {hotelling.df1} and {hotelling.df2} "
             f"degrees of freedom), {_p_text(hotelling.p)}."
         )
     if rp_a is not None and rp_b is not None:
         sentences.append(
-            f"RP went from {rp_a:.{places}f} to {rp_b:.{places}f} {unit} "
-            f"({rp_b - rp_a:+.{places}f}; RP has no test "
+            f"RP went from {format_spread(rp_a, resolution)} to "
+            f"{format_spread(rp_b, resolution, unit=unit)} "
+            f"({format_figure(rp_b - rp_a, resolution)}; RP has no test "
             "of its own: read the spreads above)."
         )
     return Comparison(

@@ -11,19 +11,18 @@ format escapes it (see :mod:`station.record.text`).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
 
-from station.analysis.report import decimals_for as report_decimals
 from station.analysis.rules import rule_name
 from station.record.source import AnalysedSession
 from station.text import (
     NOT_AVAILABLE,
+    format_figure,
+    format_index,
     format_spread,
-    format_value,
     judged_cpk,
     judged_label,
 )
@@ -70,7 +69,10 @@ class LimitLine:
 @dataclass(frozen=True)
 class ReadingRow:
     """One recorded cycle: its values per channel (in ``ReportContent.channels`` order) and its
-    status, ``ok`` or ``rejected: <reason>`` (readings are never deleted)."""
+    status, ``ok``, ``out of spec`` or ``rejected: <reason>`` (readings are never deleted).
+
+    A value the verdict judged beyond a limit carries the mark (``+0.00103 >USL``): the value
+    is written in the one number format, so the value listed is the value judged."""
 
     cycle: str
     time: str
@@ -166,32 +168,8 @@ class ReportContent:
     sign_off: tuple[str, ...] = SIGN_OFF
 
 
-def decimals_for(resolution: float | None) -> int:
-    """Decimal places to show readings at a gauge resolution: its own digits plus two (a
-    mean or σ of readings at 0.0001 in carries 6 places); 6 without a resolution."""
-    if not resolution or resolution <= 0:
-        return 6
-    return max(0, -math.floor(math.log10(resolution) + 1e-9)) + 2
-
-
-def number(value: Any, places: int, *, signed: bool = False) -> str:
-    """A finite number at ``places`` decimals (with a sign when ``signed``); MISSING for None
-    or anything that is not a finite number."""
-    if value is None or isinstance(value, bool):
-        return MISSING
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        return MISSING
-    if not math.isfinite(value):
-        return MISSING
-    text = f"{value:+.{places}f}" if signed else f"{value:.{places}f}"
-    return "+" + text[1:] if text.startswith("-") and not text.strip("-0.") else text
-
-
-def index(value: Any) -> str:
-    """A capability index at two decimals, MISSING when undefined."""
-    return number(value, 2)
+ABOVE_MARK, BELOW_MARK = ">USL", "<LSL"
+"""The mark beside a reading the verdict judged above the upper / below the lower limit."""
 
 
 def parse_time(text: str) -> datetime | None:
@@ -301,11 +279,12 @@ def _gauges(header: Mapping[str, Any], events: Sequence[Mapping[str, Any]]) -> t
     return tuple(gauges)
 
 
-def _reading(value: Any, resolution: float | None) -> str:
-    """A reading, zero offset or limit as the gauge shows it (``+0.0012``), ``-`` when absent."""
+def _figure(value: Any, resolution: float | None) -> str:
+    """A reading, zero offset or limit from the file in the one number format (``+0.00103``),
+    ``-`` when absent or not a number."""
     if value is None or isinstance(value, bool) or not isinstance(value, int | float):
         return MISSING
-    return format_value(float(value), resolution)
+    return format_figure(float(value), resolution)
 
 
 def _limits(header: Mapping[str, Any], resolution: float | None) -> tuple[LimitLine, ...]:
@@ -315,9 +294,9 @@ def _limits(header: Mapping[str, Any], resolution: float | None) -> tuple[LimitL
             lines.append(
                 LimitLine(
                     channel=str(channel),
-                    lsl=_reading(spec.get("lsl"), resolution),
-                    usl=_reading(spec.get("usl"), resolution),
-                    nominal=_reading(spec.get("nominal"), resolution),
+                    lsl=_figure(spec.get("lsl"), resolution),
+                    usl=_figure(spec.get("usl"), resolution),
+                    nominal=_figure(spec.get("nominal"), resolution),
                 )
             )
     return tuple(lines)
@@ -348,30 +327,59 @@ def _zeroes(session: Any, resolution: float | None) -> tuple[ZeroLine, ...]:
                     ),
                     channel=str(channel),
                     method=str(spec.get("method") or MISSING),
-                    offset=_reading(offset, resolution),
+                    offset=_figure(offset, resolution),
                     detail=_zero_detail(spec, resolution),
                 )
             )
     return tuple(lines)
 
 
-def _readings(session: Any, resolution: float | None) -> tuple[ReadingRow, ...]:
+def out_of_spec_marks(analysed: AnalysedSession) -> dict[tuple[str, int], tuple[float, str]]:
+    """(channel, cycle) -> (the value judged, its mark) of every reading the verdict judged
+    beyond a limit: the analysis' own out-of-spec cycles of each channel whose judged values
+    are the readings themselves (a linearity stroke's straightness is not a reading)."""
+    report = analysed.report
+    if report is None or report.analysis is None:
+        return {}
+    marks: dict[tuple[str, int], tuple[float, str]] = {}
+    for key, channel in report.analysis.channels.items():
+        found = channel.out_of_spec
+        if found is None or not found.total:
+            continue
+        cycles = channel.cycles or tuple(range(1, len(channel.readings) + 1))
+        judged = dict(zip(cycles, channel.readings, strict=True))
+        for mark, numbers in ((ABOVE_MARK, found.cycles_above), (BELOW_MARK, found.cycles_below)):
+            for number in numbers:
+                marks[(str(key), int(number))] = (float(judged[number]), mark)
+    return marks
+
+
+def _readings(analysed: AnalysedSession, resolution: float | None) -> tuple[ReadingRow, ...]:
+    session = analysed.session
+    marks = out_of_spec_marks(analysed)
     rows = []
     for cycle_number in sorted(session.cycles):
         cycle = session.cycles[cycle_number]
         reason = session.rejected.get(cycle_number)
+        values, beyond = [], False
+        for channel in session.channels:
+            reading = cycle.readings.get(channel)
+            if reading is None:
+                values.append(MISSING)
+                continue
+            text = _figure(reading.value, resolution)
+            judged = marks.get((channel, cycle_number))
+            if judged is not None and judged[0] == reading.value:
+                text, beyond = f"{text} {judged[1]}", True
+            values.append(text)
+        status = "ok" if not beyond else "out of spec"
         rows.append(
             ReadingRow(
                 cycle=str(cycle_number),
                 time=short_time(cycle.t),
                 placement=MISSING if cycle.placement is None else str(cycle.placement),
-                values=tuple(
-                    _reading(cycle.readings[c].value, resolution)
-                    if c in cycle.readings
-                    else MISSING
-                    for c in session.channels
-                ),
-                status="ok" if reason is None else f"rejected: {reason}",
+                values=tuple(values),
+                status=status if reason is None else f"rejected: {reason}",
             )
         )
     return tuple(rows)
@@ -383,18 +391,16 @@ def _verdicts(analysed: AnalysedSession, resolution: float | None) -> tuple[Verd
     verdicts = []
     for key, channel in analysed.report.analysis.channels.items():
         cap = channel.capability
-        # The decimals `station analyze` prints this channel's statistics with.
-        places = report_decimals(resolution, channel.descriptive.sd or channel.descriptive.range)
         verdicts.append(
             Verdict(
                 channel=str(key),
                 name=str(channel.name),
                 n=str(channel.descriptive.n),
-                mean=number(channel.descriptive.mean, places, signed=True),
-                sd=number(channel.descriptive.sd, places),
-                cp=index(cap.cp),
+                mean=format_figure(channel.descriptive.mean, resolution),
+                sd=format_spread(channel.descriptive.sd, resolution),
+                cp=format_index(cap.cp),
                 cpk=judged_cpk(channel),
-                cpk_lower=index(cap.cpk_lower),
+                cpk_lower=format_index(cap.cpk_lower),
                 confidence=f"{cap.confidence:.0%}",
                 word=judged_label(channel),
                 message=str(cap.message or ""),
@@ -409,13 +415,12 @@ def _figures(analysed: AnalysedSession, resolution: float | None) -> tuple[tuple
     spatial = analysed.report.analysis.spatial
     if spatial is None:
         return ()
-    places = report_decimals(resolution, spatial.l_sd or spatial.total_offset)
     figures = [
-        (f"Offset {axis} (mean − nominal)", number(value, places, signed=True))
+        (f"Offset {axis} (mean − nominal)", format_figure(value, resolution))
         for axis, value in spatial.offset.items()
     ]
-    figures.append(("Total offset (APp)", number(spatial.total_offset, places)))
-    figures.append(("Pose repeatability RP = l̄ + 3·S_l", number(spatial.rp, places)))
+    figures.append(("Total offset (APp)", format_spread(spatial.total_offset, resolution)))
+    figures.append(("Pose repeatability RP = l̄ + 3·S_l", format_spread(spatial.rp, resolution)))
     return tuple(figures)
 
 
@@ -468,7 +473,8 @@ def build_content(analysed: AnalysedSession) -> ReportContent:
         duration=duration,
         status=session.status,
         unit=session.unit,
-        resolution=MISSING if resolution is None else f"{resolution:g}",
+        # The gauge step in the one number format too (never 1e-05).
+        resolution=MISSING if resolution is None else format_spread(resolution, resolution),
         rules=str(header.get("rules") or "report"),
         threshold=f"{float(header.get('threshold') or 1.0):g}",
         trigger=str((header.get("instruments") or {}).get("trigger") or MISSING),
@@ -476,7 +482,7 @@ def build_content(analysed: AnalysedSession) -> ReportContent:
         zeroes=_zeroes(session, resolution),
         limits=_limits(header, resolution),
         channels=session.channels,
-        readings=_readings(session, resolution),
+        readings=_readings(analysed, resolution),
         rejected=tuple((str(c), str(r)) for c, r in sorted(session.rejected.items())),
         streamed=streamed,
         notes=tuple(

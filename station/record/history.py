@@ -12,7 +12,7 @@ trended together.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from datetime import datetime, timedelta
 from pathlib import Path
@@ -20,13 +20,21 @@ from typing import Any
 
 import numpy as np
 
+from station.analysis.diagnostics import p_phrase
 from station.errors import StationError
 from station.record.baseline import baseline_for
 from station.record.content import parse_time
 from station.record.source import analyse_session
 from station.record.text import plain
 from station.session.store import list_sessions
-from station.text import UNDEFINED, judged_word, overall_verdict
+from station.text import (
+    UNDEFINED,
+    format_figure,
+    format_index,
+    format_spread,
+    judged_word,
+    overall_verdict,
+)
 
 SECONDS_PER_DAY = 86400.0
 
@@ -60,6 +68,8 @@ class HistoryEntry:
     baseline: bool = False
     problem: str | None = None
     unit: str = ""
+    resolution: float | None = None
+    """The session's gauge step: its figures are written one decimal beyond it."""
 
 
 @dataclass(frozen=True)
@@ -95,6 +105,8 @@ class RobotHistory:
     skipped: tuple[tuple[Path, str], ...] = ()
     """The session files of the folder that could not be read, each with why (whose robot
     they are is unknown, or their analysis failed): left out, and said so one line each."""
+    resolution: float | None = None
+    """The latest session's gauge step, which the charts and trends are written at."""
 
 
 def _entry(path: Path, baseline_session: str | None) -> HistoryEntry:
@@ -124,6 +136,7 @@ def _entry(path: Path, baseline_session: str | None) -> HistoryEntry:
         if analysis.spatial is not None:
             rp = analysis.spatial.rp
         verdict = overall_verdict(judged_word(c) for c in analysis.channels.values())
+    recorded = session.header.get("resolution")
     return HistoryEntry(
         path=path,
         created=session.created,
@@ -137,6 +150,7 @@ def _entry(path: Path, baseline_session: str | None) -> HistoryEntry:
         baseline=baseline_session is not None and session.session_id == baseline_session,
         problem=analysed.problem,
         unit=session.unit,
+        resolution=float(recorded) if isinstance(recorded, int | float) and recorded > 0 else None,
     )
 
 
@@ -167,7 +181,9 @@ def wear_trend(
     )
 
 
-def _trends(entries: Sequence[HistoryEntry], unit: str) -> tuple[Trend, ...]:
+def _trends(
+    entries: Sequence[HistoryEntry], unit: str, resolution: float | None
+) -> tuple[Trend, ...]:
     analysed = [e for e in entries if e.channels and parse_time(e.created) is not None]
     if not analysed:
         return ()
@@ -188,20 +204,23 @@ def _trends(entries: Sequence[HistoryEntry], unit: str) -> tuple[Trend, ...]:
         latest = rows[-1].channels[channel]
         limit, limit_name = (latest.usl, "USL") if slope > 0 else (latest.lsl, "LSL")
         crossing = None
-        per_30 = f"{slope * 30:+.3g} {unit} per 30 days".strip()
-        interval = f"(95% CI {low * 30:+.3g} to {high * 30:+.3g}, p = {p_value:.3g})"
+        per_30 = f"{format_figure(slope * 30, resolution, unit=unit)} per 30 days"
+        interval = (
+            f"(95% CI {format_figure(low * 30, resolution)} to "
+            f"{format_figure(high * 30, resolution)}, {p_phrase(p_value)})"
+        )
         if significant and limit is not None and slope != 0:
             day = (limit - intercept) / slope
             if day > days[-1]:
                 crossing = (first + timedelta(days=day)).strftime("%Y-%m-%d")
                 sentence = (
                     f"{channel}: the mean moves {per_30} {interval}; at this rate it reaches "
-                    f"the {limit_name} {limit:+g} on {crossing}."
+                    f"the {limit_name} {format_figure(limit, resolution)} on {crossing}."
                 )
             else:
                 sentence = (
                     f"{channel}: the mean moves {per_30} {interval} and the trend line is "
-                    f"already past the {limit_name} {limit:+g}."
+                    f"already past the {limit_name} {format_figure(limit, resolution)}."
                 )
         elif significant:
             sentence = f"{channel}: the mean moves {per_30} {interval}; no limit to reach."
@@ -249,20 +268,30 @@ def robot_history(folder: str | Path, robot: str) -> RobotHistory:
         except StationError as error:
             skipped.append((summary.path, error.message))
     unit = entries[-1].unit if entries else ""
+    resolution = entries[-1].resolution if entries else None
     return RobotHistory(
         robot=robot,
         folder=folder,
         entries=tuple(entries),
-        trends=_trends(entries, unit),
+        trends=_trends(entries, unit, resolution),
         baseline_session=baseline_session,
         unit=unit,
         skipped=tuple(sorted(skipped)),
+        resolution=resolution,
     )
 
 
-def text_chart(values: Sequence[float | None], *, height: int = 8, width: int = 60) -> list[str]:
+def text_chart(
+    values: Sequence[float | None],
+    *,
+    height: int = 8,
+    width: int = 60,
+    label: Callable[[float], str] = format_index,
+) -> list[str]:
     """A plain-text chart of ``values`` in order (one column per value, spread over ``width``;
-    None leaves a gap): ``*`` marks, the top and bottom values labelled at the left."""
+    None leaves a gap): ``*`` marks, the top and bottom values labelled at the left as
+    ``label`` writes them (an index at two decimals; a figure in the unit by
+    :func:`~station.text.format_figure`)."""
     known = [v for v in values if v is not None and math.isfinite(v)]
     if not known:
         return ["(no values)"]
@@ -275,9 +304,9 @@ def text_chart(values: Sequence[float | None], *, height: int = 8, width: int = 
             continue
         row = height - 1 - round((value - low) / span * (height - 1))
         grid[row][column * step] = "*"
-    labels = [f"{high:>11.4g} |", *[" " * 11 + " |"] * (height - 2), f"{low:>11.4g} |"]
+    labels = [f"{label(high):>11} |", *[" " * 11 + " |"] * (height - 2), f"{label(low):>11} |"]
     if height == 1:
-        labels = [f"{high:>11.4g} |"]
+        labels = [f"{label(high):>11} |"]
     lines = [label + "".join(row).rstrip() for label, row in zip(labels, grid, strict=True)]
     lines.append(" " * 12 + "+" + "-" * (step * len(values)))
     return lines
@@ -342,7 +371,7 @@ def history_json(history: RobotHistory) -> dict[str, Any]:
 
 def format_history(history: RobotHistory) -> list[str]:
     """The text of ``station history``: the table, charts of RP and Cpk, the trends."""
-    unit = history.unit
+    unit, resolution = history.unit, history.resolution
     lines = [f"History of robot {plain(history.robot)} ({len(history.entries)} sessions)"]
     lines.append(f"Sessions folder: {plain(history.folder)}")
     lines.append("")
@@ -350,20 +379,25 @@ def format_history(history: RobotHistory) -> list[str]:
         mark = "  [baseline]" if entry.baseline else ""
         moment = parse_time(entry.created)
         when = moment.strftime("%Y-%m-%d %H:%M") if isinstance(moment, datetime) else entry.created
-        rp = "—" if entry.rp is None else f"{entry.rp:.6f}"
+        rp = "—" if entry.rp is None else format_spread(entry.rp, entry.resolution)
         lines.append(
             f"{number:>3}. {when}  {plain(entry.procedure)}  {entry.verdict}  RP {rp} {unit}{mark}"
         )
         for name, c in entry.channels.items():
-            sd = "—" if c.sd is None else f"{c.sd:.6f}"
-            cpk = "—" if c.cpk is None else f"{c.cpk:.2f}"
-            lines.append(f"       {plain(name):<10} offset {c.offset:+.6f}  σ {sd}  Cpk {cpk}")
+            sd = "—" if c.sd is None else format_spread(c.sd, entry.resolution)
+            cpk = "—" if c.cpk is None else format_index(c.cpk)
+            offset = format_figure(c.offset, entry.resolution)
+            lines.append(f"       {plain(name):<10} offset {offset}  σ {sd}  Cpk {cpk}")
         if entry.problem:
             lines.append(f"       {plain(entry.problem)}")
         lines.append(f"       anchor {entry.anchor}  ({plain(entry.path.name)})")
     rps = [e.rp for e in history.entries]
     if any(v is not None for v in rps):
-        lines += ["", f"RP over the sessions ({unit}):", *text_chart(rps)]
+
+        def rp_label(value: float) -> str:
+            return format_spread(value, resolution)
+
+        lines += ["", f"RP over the sessions ({unit}):", *text_chart(rps, label=rp_label)]
     channels = list(dict.fromkeys(n for e in history.entries for n in e.channels))
     for name in channels:
         cpks = [e.channels[name].cpk if name in e.channels else None for e in history.entries]

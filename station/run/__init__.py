@@ -31,7 +31,7 @@ from station.run.state import (
     StepView,
     StrokeOutcome,
 )
-from station.text import format_value, value_decimals
+from station.text import figure_decimals, format_figure
 
 __all__ = [
     "ACTION_KINDS",
@@ -51,7 +51,8 @@ __all__ = [
     "SessionSetup",
     "StepView",
     "StrokeOutcome",
-    "format_value",
+    "figure_decimals",
+    "format_figure",
     "open_gauges",
     "plan_steps",
     "procedure_limits",
@@ -59,5 +60,4 @@ __all__ = [
     "resume_setup",
     "set_problem",
     "setup_from_header",
-    "value_decimals",
 ]

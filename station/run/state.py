@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
-from station.text import format_figure, format_value
+from station.text import format_figure
 
 if TYPE_CHECKING:
     from station.procedures import InputField, Step
@@ -148,15 +148,16 @@ class CycleRecord:
     part: int | None = None
     """The part a ``parts`` step measured in this cycle, else None."""
 
-    def line(self, *, figures: bool = False) -> str:
-        """The one-line form ``cycle 7 x=+0.0012 y=-0.0003 z=+0.0001`` (values at the
-        resolution's decimals, as the gauge shows them; ``cycle 7 part 3 x=...`` for a part);
-        ``figures=True`` writes them at the figures' decimals instead (``x=+0.00120``), for a
-        screen that shows statistics beside them in that one format."""
-        write = format_figure if figures else format_value
+    def line(self) -> str:
+        """The one-line form ``cycle 7 x=+0.00120 y=-0.00032 z=+0.00010`` (``cycle 7 part 3
+        x=...`` for a part): the values as the session file holds them (after the zero, which
+        is a mean and so no whole gauge step), in the one number format
+        (:func:`~station.text.format_figure`): what the operator is told was captured is what
+        was saved and is judged."""
         part = "" if self.part is None else f"part {self.part} "
         return f"cycle {self.cycle} {part}" + " ".join(
-            f"{channel}={write(value, self.resolution)}" for channel, value in self.values.items()
+            f"{channel}={format_figure(value, self.resolution)}"
+            for channel, value in self.values.items()
         )
 
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from station.errors import StationError
-from station.text import format_value
+from station.text import format_figure
 
 DEMO_PROTOCOL = "mitutoyo"
 TEST_CAPTURES = 5
@@ -285,7 +285,7 @@ def test_connection(
         for number in range(1, captures + 1):
             result = gauges.capture(timeout)
             values = "  ".join(
-                f"{channel}={format_value(reading.value, resolution)}"
+                f"{channel}={format_figure(reading.value, resolution)}"
                 for channel, reading in result.readings.items()
             )
             # The frame's own unit when it states one, else the set-up's (``unit`` of a

@@ -62,36 +62,43 @@ def test_trends_and_runs_flag_every_point_that_extends_them():
 
 
 def test_alarms_group_contiguous_points_on_one_side_and_say_where():
-    alarms = check_rules([0.0, 3.5, 3.6, 0.0, -3.2], 0.0, 1.0, "western-electric", unit="in")
+    alarms = check_rules(
+        [0.0, 3.5, 3.6, 0.0, -3.2], 0.0, 1.0, "western-electric", unit="in", resolution=0.1
+    )
     beyond = [a for a in alarms if a.rule == "we-1"]
     assert beyond == [
         Alarm(
             "we-1",
             (2, 3),
-            "Points 2 and 3 are above the upper control limit (3.0 in): "
+            "Points 2 and 3 are above the upper control limit (+3.00 in): "
             "look for a cause at those cycles.",
         ),
         Alarm(
             "we-1",
             (5,),
-            "Point 5 is below the lower control limit (-3.0 in): look for a cause at that cycle.",
+            "Point 5 is below the lower control limit (-3.00 in): look for a cause at that cycle.",
         ),
     ]
 
 
 def test_the_report_example_sentence():
+    """The control line in the one number format (issue 22): signed, one decimal beyond the
+    0.0001 in gauge step, as every other figure (it was ``0.00081``, unsigned)."""
     sigma = 0.00027
     points = [0.0001] * 14 + [0.0009]
-    (alarm,) = [a for a in check_rules(points, 0.0, sigma, unit="in") if a.rule == "report-1"]
+    alarms = check_rules(points, 0.0, sigma, unit="in", resolution=0.0001)
+    (alarm,) = [a for a in alarms if a.rule == "report-1"]
     assert alarm.text == (
-        "Point 15 is above the upper control limit (0.00081 in): look for a cause at that cycle."
+        "Point 15 is above the upper control limit (+0.00081 in): look for a cause at that cycle."
     )
 
 
 def test_pattern_alarms_name_the_pattern_and_the_direction():
-    (alarm,) = check_rules([0.1] * 9, 0.0, 1.0, "nelson")
+    (alarm,) = check_rules([0.1] * 9, 0.0, 1.0, "nelson", resolution=0.01)
     assert alarm.rule == "nelson-2"
-    assert alarm.text.startswith("Point 9 completes 9 points in a row above the centre line (0.0)")
+    assert alarm.text.startswith(
+        "Point 9 completes 9 points in a row above the centre line (+0.000)"
+    )
     assert "shifted up" in alarm.text
     falling = check_rules(RISING_7[::-1] + [-0.8], 0.0, 1.0, "report")
     assert [a.rule for a in falling] == ["report-2"]

@@ -306,7 +306,10 @@ def test_a_csv_cycle_column_numbers_the_readings(tmp_path):
     assert document["channels"]["x"]["cycles"] == list(range(10, 35))
     (alarm,) = document["channels"]["x"]["alarms"]
     assert alarm["cycles"] == [34] and alarm["text"].startswith("Cycle 34 ")
-    assert _pieces(station(path).stdout)[34] == "+9.00"
+    # No gauge step given: every figure at six decimals (the one format's rule for an unknown
+    # step), as station analyze --resolution 0.1 would write +9.00.
+    assert _pieces(station(path).stdout)[34] == "+9.000000"
+    assert _pieces(station(path, "--resolution", "0.1").stdout)[34] == "+9.00"
     unnumbered = write_csv(
         tmp_path, "plain.csv", "x\n" + "\n".join(r.split(",")[1] for r in rows[1:])
     )

@@ -50,7 +50,9 @@ def test_a_moving_channel_is_refused_by_name() -> None:
     with pytest.raises(StationError) as caught:
         zero_from_readings(readings, 0.001, window=1.0, unit="mm")
     message = caught.value.message
-    assert "y moves" in message and "0.008 mm over 1.0 s" in message
+    # The spread and the step in the one number format: one decimal beyond the 0.001 mm step.
+    assert "y moves" in message and "0.0080 mm over 1.0 s" in message
+    assert "more than 3 × 0.0010)" in message
     assert "x moves" not in message and "z moves" not in message
     assert "zero again" in message
 

@@ -58,7 +58,7 @@ def test_history_shows_the_wear_trend_and_its_crossing_date(sessions, capsys):
     assert main(["history", "KSC-7", "--sessions", str(sessions)]) == 0
     out = capsys.readouterr().out
     assert "History of robot KSC-7 (5 sessions)" in out
-    assert f"reaches the USL +0.001 on {x.crossing}" in out
+    assert f"reaches the USL +0.00100 on {x.crossing}" in out
     assert "RP over the sessions" in out and "Cpk of x over the sessions" in out
     assert "y: no significant trend" in out
 

@@ -3,9 +3,11 @@ Chromium, the Markdown in a standard parser."""
 
 from __future__ import annotations
 
+import io
 import re
 import shutil
 import subprocess
+import sys
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -224,6 +226,34 @@ def test_report_command_writes_refuses_and_chooses_the_format(sessions, capsys):
     assert run_station("report", str(path), "--format", "txt") == 0
     assert capsys.readouterr().out == render_report(path, "txt")
     assert run_station("report", str(sessions / "missing.jsonl")) == 2
+
+
+class _Terminal(io.StringIO):
+    """Standard output that says it is a terminal."""
+
+    def isatty(self) -> bool:
+        return True
+
+
+def test_report_at_a_terminal_writes_text_and_refuses_html_in_one_line(
+    sessions, capsys, monkeypatch
+):
+    """Issue 22: ``station report FILE --format html`` without ``-o`` wrote 170 KB of SVG to
+    the terminal. There it is one line saying ``-o``; a pipe still gets the page."""
+    path = write_repeatability(sessions, cycles=6)
+    terminal = _Terminal()
+    monkeypatch.setattr(sys, "stdout", terminal)
+    assert run_station("report", str(path)) == 0
+    assert terminal.getvalue() == render_report(path, "txt")
+    terminal.seek(0)
+    terminal.truncate()
+    assert run_station("report", str(path), "--format", "html") == 2
+    assert terminal.getvalue() == ""
+    error = capsys.readouterr().err
+    assert error.count("\n") == 1 and "-o " in error and "terminal" in error, error
+    monkeypatch.undo()
+    assert run_station("report", str(path), "--format", "html") == 0
+    assert capsys.readouterr().out.startswith("<!DOCTYPE html>")
 
 
 def test_a_session_without_readings_still_reports(sessions):

@@ -16,7 +16,7 @@ import pytest
 
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import AxisModel, GaugeSpec, Simulator, fixture_model
-from station.run import format_value
+from station.run import format_figure
 from station.session.model import Session
 
 REPO = Path(__file__).resolve().parents[2]
@@ -155,12 +155,12 @@ def capture_args(
 
 
 def values_text(session: Session, cycle: int) -> str:
-    """A recorded cycle's values as ``station capture`` prints them: at the decimals of the
-    session's gauge resolution."""
+    """A recorded cycle's values as ``station capture`` prints them: one decimal beyond the
+    session's gauge step."""
     readings = session.cycles[cycle].readings
     resolution = session.header["resolution"]
     return " ".join(
-        f"{channel}={format_value(reading.value, resolution)}"
+        f"{channel}={format_figure(reading.value, resolution)}"
         for channel, reading in readings.items()
     )
 

@@ -47,8 +47,8 @@ def test_full_headless_session(simulator, procedures, tmp_path):
     lines = done.stdout.splitlines()
     cycle_lines = [line for line in lines if line.startswith("cycle ")]
     # Two single captures (x, y) in the repeat block, then four cycles of x, y, z: values at
-    # the 0.0001 in gauges' four decimals.
-    assert re.fullmatch(r"cycle 1 x=[+-]\d\.\d{4} y=[+-]\d\.\d{4}", cycle_lines[0])
+    # one decimal beyond the 0.0001 in gauges' step, as every figure.
+    assert re.fullmatch(r"cycle 1 x=[+-]\d\.\d{5} y=[+-]\d\.\d{5}", cycle_lines[0])
     assert re.fullmatch(r"cycle 6 x=\S+ y=\S+ z=\S+", cycle_lines[-1])
     assert len(cycle_lines) == 6
     path = Path(lines[-2].removeprefix("session file: "))
@@ -163,10 +163,11 @@ def test_unit_and_resolution_options(procedures, tmp_path):
     session = load_session(path, recover=False)
     assert (session.header["unit"], session.header["resolution"]) == ("mm", 0.001)
     assert session.header["limits"]["x"]["usl"] == 0.05
-    assert "Unit: mm   Resolution: 0.001 " in done.stdout
+    # The gauge step and every figure one decimal beyond it (the one number format).
+    assert "Unit: mm   Resolution: 0.0010 " in done.stdout
     cycle_lines = [line for line in done.stdout.splitlines() if line.startswith("cycle ")]
     assert len(cycle_lines) == 3
-    assert all(re.fullmatch(r"cycle \d (\w=[+-]\d+\.\d{3} ?){3}", line) for line in cycle_lines)
+    assert all(re.fullmatch(r"cycle \d (\w=[+-]\d+\.\d{4} ?){3}", line) for line in cycle_lines)
 
 
 def test_gauges_in_another_unit_are_refused_before_the_session(procedures, tmp_path):

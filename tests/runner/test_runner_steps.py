@@ -20,7 +20,7 @@ from station.run import (
     Runner,
     RunnerNotice,
     SessionSetup,
-    format_value,
+    format_figure,
     open_gauges,
     setup_from_header,
 )
@@ -128,8 +128,8 @@ def test_a_capture_under_way_stays_in_its_step(answering_pty, gauges_for, tmp_pa
         assert outcomes[0].recorded, outcomes[0].message
         assert outcomes[0].cycle.step_id == "first"
         assert runner.state().current.id == "first"
-        # Values at the session's resolution (0.0001 in: four decimals), not +.5f.
-        assert outcomes[0].message == "cycle 2 x=+0.0012 y=+0.0022 z=+0.0032"
+        # Values in the one number format: one decimal beyond the 0.0001 in gauge step.
+        assert outcomes[0].message == "cycle 2 x=+0.00120 y=+0.00220 z=+0.00320"
         runner.confirm()
         assert runner.state().current.id == "second"
     finally:
@@ -138,13 +138,16 @@ def test_a_capture_under_way_stays_in_its_step(answering_pty, gauges_for, tmp_pa
     assert [c.step for c in session.cycles.values()] == ["first", "first"]
 
 
-def test_values_show_the_resolution_decimals():
-    """Finding 16: one formatting for the cycle line, at the gauge's decimals."""
-    assert format_value(0.00123, 0.0001) == "+0.0012"
-    assert format_value(-0.0012, 0.001) == "-0.001"
-    assert format_value(-0.00004, 0.0001) == "+0.0000"  # no "-0.0000" beside "+0.0000"
-    assert format_value(0.000012, 0.00001) == "+0.00001"
-    assert format_value(0.25, 0.0005) == "+0.2500"
+def test_values_show_one_decimal_beyond_the_gauge_step():
+    """Finding 16, then issue 22: one formatting for every figure, one decimal beyond the
+    gauge step (a reading after a zero taken as a mean is no whole step: +0.00123 stays)."""
+    assert format_figure(0.00123, 0.0001) == "+0.00123"
+    assert format_figure(-0.0012, 0.001) == "-0.0012"
+    assert format_figure(-0.000004, 0.0001) == "+0.00000"  # no "-0.00000" beside "+0.00000"
+    assert format_figure(0.000012, 0.00001) == "+0.000012"
+    assert format_figure(0.25, 0.0005) == "+0.25000"
+    assert format_figure(0.00002, 0.0001, signed=False, unit="in") == "0.00002 in"
+    assert format_figure(1e-05, None) == "+0.000010"  # an unknown step: six decimals, no 1e-05
 
 
 def test_header_limits_read_the_same_for_analysis_and_resume():

@@ -3,23 +3,18 @@ by keyboard in Pilot (set-up, checklist, cycles)."""
 
 from __future__ import annotations
 
-import re
 import time
 import unicodedata
 from collections.abc import Callable, Iterator
 from types import SimpleNamespace
 
 import pytest
+from helpers import odd_figures
 from textual import events
 from textual.keys import REPLACED_KEYS, _character_to_key, _get_unicode_name_from_key
 from textual.widgets import Input, Select
 
-from station.text import figure_decimals
 from station.tui.instruments import DemoFixture, start_demo_fixture
-
-FIGURE = re.compile(r"(?<![\w.])[-+]?\d+\.(\d+)(?![\w.])")
-SCIENTIFIC = re.compile(r"(?<![\w.])[-+]?\d+(?:\.\d+)?[eE][-+]?\d+(?![\w.])")
-SIGNED_SPREAD = re.compile(r"(?:σ|SIGMA:?|sigma|RANGE:?|range)\s+[-+]\d")
 
 
 @pytest.fixture
@@ -134,31 +129,6 @@ def screen_text(app) -> str:
         "".join(segment.text for segment in strip)
         for strip in app.screen._compositor.render_strips()
     )
-
-
-def odd_figures(text: str, resolution: float = 0.0001) -> list[str]:
-    """The figures on a screen that break its one format (empty when there are none): a
-    number in scientific notation, a signed spread, or a figure with more than two decimals
-    (an index) but other than the figures' decimals at ``resolution``."""
-    decimals = figure_decimals(resolution)
-    odd = [match.group(0) for match in SCIENTIFIC.finditer(text)]
-    odd += [match.group(0) for match in SIGNED_SPREAD.finditer(text)]
-    lines = text.splitlines()
-    # The teach pendant's coordinates are typed as the pendant shows them (its own decimals).
-    pendant = next((i for i, line in enumerate(lines) if "PENDANT" in line), None)
-    if pendant is not None:
-        end = next((i for i in range(pendant, len(lines)) if not lines[i].strip()), len(lines))
-        lines = lines[:pendant] + lines[end:]
-    for line in lines:
-        for match in FIGURE.finditer(line):
-            places = len(match.group(1))
-            # A p-value, a correlation or a skewness is no figure in the unit.
-            if re.search(r"\b(?:p|r|a1) [=<] $", line[: match.start()]):
-                continue
-            # Two decimals: an index (Cp, Cpk, a₁, a percent); anything longer is a figure.
-            if places > 2 and places != decimals:
-                odd.append(f"{match.group(0)} in {line.strip()!r}")
-    return odd
 
 
 @pytest.fixture

@@ -573,9 +573,11 @@ async def test_relative_accuracy_at_80x24_pendant_fields_instruction_and_capture
             captured = str(app.screen.query_one("#step-captured", Static).render())
             assert captured.startswith("Captured (set ") and " in" in captured, captured
             assert all(f"{axis} " in captured for axis in "xyz"), captured
-            assert captured in _screen_text(app).replace("│", " ").replace("\n", " ") or all(
-                part in _screen_text(app) for part in captured.split("  ")
-            )
+            # Drawn whole (wrapped, perhaps, between a channel and its figure), never cut.
+            shown = " ".join(_screen_text(app).replace("│", " ").split())
+            assert " ".join(captured.split()) in shown or all(
+                word in shown for word in captured.split()
+            ), (captured, shown)
     finally:
         lab.stop()
 
@@ -604,7 +606,8 @@ async def test_no_readings_yet_only_with_none(tmp_path: Path, fixture_pty, tui) 
 async def test_test_connection_reads_at_the_resolution_with_the_unit(
     tmp_path: Path, fixture_pty, tui
 ) -> None:
-    """Finding 9: the live readings of F3 showed five decimals and no unit."""
+    """Finding 9: the live readings of F3 showed no unit. Issue 22: in the one number format
+    of every screen (one decimal beyond the gauge step), not the gauge's own four."""
     import re
 
     app = _app(tmp_path)
@@ -616,8 +619,8 @@ async def test_test_connection_reads_at_the_resolution_with_the_unit(
         lines = [line for line in str(output.render()).splitlines() if "x=" in line]
         assert lines
         for line in lines:
-            # 0.0001 in gauge: four decimals, as the gauge shows them, and the unit.
-            assert re.search(r"x=[+-]\d\.\d{4}  y=[+-]\d\.\d{4}  z=[+-]\d\.\d{4} in$", line), line
+            # 0.0001 in gauge: five decimals, as every figure, and the unit.
+            assert re.search(r"x=[+-]\d\.\d{5}  y=[+-]\d\.\d{5}  z=[+-]\d\.\d{5} in$", line), line
 
 
 async def test_exporting_from_the_summary_says_so_without_covering_it(

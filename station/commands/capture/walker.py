@@ -4,6 +4,7 @@ and the line it prints per stroke streamed."""
 
 from __future__ import annotations
 
+import functools
 import sys
 import threading
 import time
@@ -12,6 +13,7 @@ from typing import Any
 from station.commands.capture.inputs import Inputs, values_for
 from station.errors import StationError
 from station.instruments.zeroing import GaugesMoving, NotAtFixture
+from station.text import format_spread
 
 BY = "station capture"
 """Who confirmed what the command did, as the session file records it."""
@@ -198,7 +200,9 @@ class Headless:
             self.timeout,
             deadband=self.deadband,
             still_seconds=self.still,
-            on_stroke=print_stroke,
+            on_stroke=functools.partial(
+                print_stroke, resolution=self.runner.setup.resolved_resolution
+            ),
             by=BY,
         )
 
@@ -244,15 +248,16 @@ class Headless:
     }
 
 
-def print_stroke(outcome: Any) -> None:
+def print_stroke(outcome: Any, resolution: float | None = None) -> None:
     """``stroke 7 A→B 412 points h=0.00123 v=0.00061 (LS straightness)``, once the stroke's
-    points are on disk (``on_stroke`` of the runner's stream)."""
+    points are on disk (``on_stroke`` of the runner's stream); the straightness in the one
+    number format at the gauge ``resolution``."""
     from station.analysis.linearity import straightness
 
     profile = outcome.profile
     position = profile.get("s")
     figures = " ".join(
-        f"{channel}={straightness(position, values).ls:.5f}"
+        f"{channel}={format_spread(straightness(position, values).ls, resolution)}"
         for channel, values in profile.items()
         if channel != "s" and position is not None and len(values) >= 2
     )

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from station.analysis.diagnostics import two_digits
 from station.errors import StationError
 from station.methods.contract import (
     Chart,
@@ -51,6 +52,7 @@ from station.methods.text import fitted
 from station.procedures import AnalysisNeeds
 from station.session.gauge_register import port_of, record_study, register_path
 from station.session.tables import require_columns
+from station.text import format_figure
 
 if TYPE_CHECKING:
     from _typeshed import SupportsWrite
@@ -125,7 +127,7 @@ def bias_chart(study: LinearityStudy, references: Any, values: Any, kit: ChartKi
         * study.s
         * np.sqrt(1.0 / study.n + (grid - x_bar) ** 2 / sxx)
     )
-    axes.plot(grid, line, color=kit.centre, label=f"fitted bias (slope {study.slope:+.3g})")
+    axes.plot(grid, line, color=kit.centre, label=f"fitted bias (slope {two_digits(study.slope)})")
     axes.fill_between(grid, line - half, line + half, color=kit.centre, alpha=0.15, label="95 %")
     axes.axhline(0.0, color="grey", linestyle=":", label="bias = 0")
     if study.allowed_bias is not None:
@@ -134,12 +136,14 @@ def bias_chart(study: LinearityStudy, references: Any, values: Any, kit: ChartKi
                 sign * study.allowed_bias,
                 color=kit.limit,
                 linestyle="--",
-                label=f"allowed ±{study.allowed_bias:.3g}" if sign > 0 else None,
+                label=f"allowed ±{kit.number(study.allowed_bias, signed=False)}"
+                if sign > 0
+                else None,
             )
     axes.set_title(f"Bias against the reference size: {study.verdict}")
     axes.set_xlabel("reference size" + suffix)
     axes.set_ylabel("bias" + suffix)
-    axes.legend(loc="best", fontsize=7)
+    kit.legend(axes)
     return figure
 
 
@@ -267,8 +271,8 @@ class GaugeLinearity(Method):
             {
                 "date": date,
                 "result": study.verdict.lower(),
-                "summary": f"slope {study.slope:+.3g}, average bias {study.average_bias:+.3g}"
-                + (f" {study.unit}" if study.unit else ""),
+                "summary": f"slope {two_digits(study.slope)}, average bias "
+                + format_figure(study.average_bias, study.resolution, unit=study.unit),
                 "slope": study.slope,
                 "intercept": study.intercept,
                 "r2": study.r2,
@@ -285,8 +289,8 @@ class GaugeLinearity(Method):
         )
         return [
             f"Gauge linearity study of {gauge}: {study.verdict} on {entry['date']} (slope "
-            f"{study.slope:+.3g}, %linearity {study.pct_linearity:.3g} %); filed in the gauge "
-            f"register {target}."
+            f"{two_digits(study.slope)}, %linearity {study.pct_linearity:.3g} %); filed in the "
+            f"gauge register {target}."
         ]
 
     def demo_rig(self, gauge: GaugeSpec, seed: int, *, stroke_points: int) -> DemoRig:

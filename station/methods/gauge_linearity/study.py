@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 
 from station.errors import StationError
+from station.text import format_figure
 
 ALPHA = 0.05
 """The significance level of every test, and 1 − the confidence of every band."""
@@ -206,7 +207,10 @@ class LinearityStudy:
     def lines(self) -> list[str]:
         """The study as plain report lines (the verdict first, then the figures and notes)."""
         unit = f" {self.unit}" if self.unit else ""
-        g = _figure
+
+        def g(value: float | None, *, signed: bool = True) -> str:
+            return _figure(value, self.resolution, signed=signed)
+
         lines = [
             f"GAUGE LINEARITY AND BIAS STUDY: {self.verdict}",
             f"  {self.sentence}",
@@ -278,16 +282,16 @@ class LinearityStudy:
             unit = f" {self.unit}" if self.unit else ""
             notes.append(
                 f"the verdict allows a bias within {self.share:.0%} of the tolerance "
-                f"(±{_figure(self.allowed_bias, signed=False)}{unit}) anywhere over the range, "
+                f"(±{_figure(self.allowed_bias, self.resolution, signed=False)}{unit}) anywhere "
+                "over the range, "
                 "at 95 % confidence."
             )
         return notes
 
 
-def _figure(value: float | None, *, signed: bool = True) -> str:
-    if value is None:
-        return "-"
-    return f"{value:+.4g}" if signed else f"{value:.4g}"
+def _figure(value: float | None, resolution: float | None, *, signed: bool = True) -> str:
+    """A figure in the unit as every report writes it (:func:`~station.text.format_figure`)."""
+    return format_figure(value, resolution, signed=signed)
 
 
 def _percent(value: float | None) -> str:

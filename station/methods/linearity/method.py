@@ -70,7 +70,12 @@ def profile_chart(
         straight = widest.straightness[channel]
         axes.plot(s, d, color=kit.point, linewidth=1.2, label=f"stroke {widest.number}")
         a, b = straight.ls_line
-        axes.plot(s, a + b * s, color=kit.centre, label=f"LS line (LS {straight.ls:.4g})")
+        axes.plot(
+            s,
+            a + b * s,
+            color=kit.centre,
+            label=f"LS line (LS {kit.number(straight.ls, signed=False)})",
+        )
         a, b = straight.mz_line
         for offset in (-straight.mz / 2, straight.mz / 2):
             axes.plot(
@@ -78,13 +83,15 @@ def profile_chart(
                 a + b * s + offset,
                 color=kit.limit,
                 linestyle="--",
-                label=f"minimum zone (MZ {straight.mz:.4g})" if offset > 0 else None,
+                label=f"minimum zone (MZ {kit.number(straight.mz, signed=False)})"
+                if offset > 0
+                else None,
             )
     suffix = f" ({kit.label(unit)})" if unit else ""
     axes.set_title(f"Straightness profiles of {kit.label(channel)} along the bar")
     axes.set_xlabel("position s" + suffix)
     axes.set_ylabel(f"deviation {kit.label(channel)}{suffix}")
-    axes.legend(loc="upper right", fontsize=7)
+    kit.legend(axes)
     return figure
 
 

@@ -19,7 +19,7 @@ from textual.screen import Screen
 from textual.widgets import Footer, Label, Static
 
 from station.errors import StationError
-from station.text import format_value
+from station.text import format_figure
 from station.tui.remedies import explained
 from station.tui.screens.dialogs import ConfirmScreen, HelpScreen, TextPrompt
 from station.tui.text import shown, shown_line
@@ -315,14 +315,14 @@ class ChecklistScreen(Screen[None]):
 
 
 def captured_text(record: Any, header: dict[str, Any]) -> Text:
-    """``Captured (set 3): x +0.0003  y -0.0001  z +0.0002 in``: the set just recorded, at
-    the gauge's resolution."""
+    """``Captured (set 3): x +0.00030  y -0.00012  z +0.00020 in``: the set just recorded, as
+    the session file holds it (after the zero) in the one number format."""
 
     resolution = header.get("resolution")
     unit = str(header.get("unit") or "")
     text = Text(f"Captured (set {record.cycle}): ", style="bold")
     values = "  ".join(
-        f"{shown_line(channel, limit=20)} {format_value(value, resolution)}"
+        f"{shown_line(channel, limit=20)} {format_figure(value, resolution)}"
         for channel, value in record.values.items()
     )
     text.append(f"{values} {unit}".rstrip(), style="bold")

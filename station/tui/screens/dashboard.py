@@ -373,9 +373,8 @@ class DashboardScreen(Screen[None]):
             self._say(message.error, "bold red")
         elif message.outcome is not None:
             outcome = message.outcome
-            # A recorded cycle in the table's own format (the engine words it as the gauge
-            # shows it, for the command line).
-            said = outcome.cycle.line(figures=True) if outcome.cycle is not None else None
+            # A recorded cycle in the table's own format.
+            said = outcome.cycle.line() if outcome.cycle is not None else None
             self._say(said or outcome.message, "green" if outcome.recorded else "bold red")
 
     def _in_thread(self, call: Callable[[], Any]) -> None:
