@@ -211,7 +211,8 @@ UNSIGNED_POSITION = re.compile(
 """A position (a limit, a control line, a mean, an offset, a reading after ``=``) written
 without its sign (a moving range's ``MR UCL`` is a spread)."""
 DIMENSIONLESS = re.compile(
-    r"(?:\b(?:p|r|a1|t|W|statistic|T²|F|Cp|Cpk|Cpu|Cpl|Pp|Ppk|ratio|lambda|SKEWNESS a1:)\s*[=<]?\s*"
+    r"(?:\b(?:p|r|a1|t|W|statistic|T²|F|Cp|Cpk|Cpu|Cpl|Pp|Ppk|ratio|lambda|SKEWNESS a1:|bounds)"
+    r"\s*[=<]?\s*"
     r"|CI )$"
 )
 """What stands just before a number that is no figure in the unit (a p-value, a statistic,

@@ -73,8 +73,8 @@ exit codes:
   1  with --fail-if-incapable: a channel is NOT CAPABLE (its confidence bound
      is below the threshold), has no verdict (no limits) or only a provisional
      one (fewer readings than --min-n); a study with a verdict of its own
-     (gauge_linearity, gage_rr) is not ACCEPTABLE. An INCONCLUSIVE channel (its bounds
-     straddle the threshold) passes, with a note on stderr; with
+     (gauge_linearity, gage_rr) is not ACCEPTABLE. An INCONCLUSIVE channel
+     (its bounds straddle the threshold) passes, with a note on stderr; with
      --fail-if-inconclusive it fails too
   2  bad input: missing or empty file, a cell that is not a number, impossible
      limits
