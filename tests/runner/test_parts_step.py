@@ -80,8 +80,8 @@ def test_every_part_once_in_its_drawn_order(simulator, gauges_for, tmp_path, see
     with pytest.raises(StationError, match=r"2 of 3 parts are not read yet \(part \d is next\)"):
         runner.confirm()
     # A rejected reading's part is asked for again, before the rest of the order.
-    runner.capture(3.0)
-    runner.reject_last("the part was not seated")
+    second = runner.capture(3.0)
+    runner.reject(second.cycle.cycle, "the part was not seated")
     assert runner.state().action.part == order[1]
     for expected in order[1:]:
         assert runner.capture(3.0).cycle.part == expected

@@ -54,7 +54,7 @@ async def test_the_dialog_rejects_the_cycle_it_names_while_cycles_arrive(
         await pilot.pause(0.3)
         await pilot.press("f2")
         await tui.walk_checklist(pilot)
-        await tui.wait_until(pilot, lambda: app.runner.state().cycles, timeout=6 * PERIOD)
+        await tui.wait_until(pilot, lambda: app.runner.state().cycles, timeout=30 * PERIOD)
         # Wait for the dashboard to draw it: `r` names the cycle the screen knows of.
         await tui.wait_until(pilot, lambda: app.current_state().last_cycle is not None)
         await pilot.press("r")
