@@ -156,7 +156,7 @@ def test_station_tui_opens_the_home_screen_and_ctrl_c_quits(tmp_path: Path) -> N
         station.wait_for("New session", timeout=30)
         station.wait_for("Sessions folder", timeout=10)
         os.write(station._master, b"\x03")
-        assert station.process.wait(20) == 0
+        assert station.process.wait(60) == 0
     finally:
         station.close()
 

@@ -127,7 +127,8 @@ def test_arrival_records_ten_cycles_one_per_round_trip_at_rest(
     times = [min(r.t_mono for r in cycle.readings.values()) for cycle in cycles]
     for i in range(len(times) - 1):
         apart = (rests[i + 1] - rests[i]) * PERIOD
-        assert abs(times[i + 1] - times[i] - apart) < 0.3 * PERIOD, (times, rests)
+        # (half a period of slack: a loaded machine reads a rest late, never a return twice)
+        assert abs(times[i + 1] - times[i] - apart) < 0.5 * PERIOD, (times, rests)
     assert rests[-1] - rests[0] <= 12, rests  # nearly every round trip was a cycle
 
 
