@@ -18,6 +18,7 @@ from station.methods.gauge_check import METHOD as GAUGE_CHECK
 from station.methods.gauge_linearity import METHOD as GAUGE_LINEARITY
 from station.methods.joint_troubleshooting import METHOD as JOINT_TROUBLESHOOTING
 from station.methods.linearity import METHOD as LINEARITY
+from station.methods.pose_characteristics import METHOD as POSE_CHARACTERISTICS
 from station.methods.relative_accuracy import METHOD as RELATIVE_ACCURACY
 from station.methods.repeatability import METHOD as REPEATABILITY
 from station.procedures import AnalysisNeeds, discover_procedures, use_methods
@@ -31,6 +32,7 @@ BUILT_IN: tuple[Method, ...] = (
     GAUGE_LINEARITY,
     JOINT_TROUBLESHOOTING,
     GAIN_SCHEDULE,
+    POSE_CHARACTERISTICS,
 )
 """The station's own methods; the first is the default (a procedure that declares none and
 whose steps imply none)."""

@@ -39,10 +39,11 @@ if TYPE_CHECKING:
 Layout = Literal["tidy", "wide"]
 """A CSV export's layout: a row per reading (tidy) or the table the method's analysis reads."""
 
-OPTIONS = ("reference", "tolerance", "process_variation", "order")
+OPTIONS = ("reference", "tolerance", "process_variation", "order", "distance")
 """The values a command line may give a method's batch analysis (``station analyze``): a
-reference size, a tolerance, a process variation (6σ), a fit's order. A method names the ones it
-takes in :attr:`Method.options`."""
+reference size, a tolerance, a process variation (6σ), a fit's order, the two poses a distance
+is measured between (the text ``P2:P4=27.71``, which the method reads). A method names the ones
+it takes in :attr:`Method.options`."""
 
 
 # -- what a method is given and gives back -----------------------------------------------------

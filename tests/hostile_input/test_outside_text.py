@@ -40,6 +40,7 @@ PROCEDURES = (
     "gauge_linearity",
     "joint_troubleshooting",
     "gain_schedule",
+    "pose_characteristics",
 )
 
 
