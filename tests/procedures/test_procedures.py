@@ -348,6 +348,7 @@ def test_the_analysis_kind_defaults_by_step_kinds(tmp_path: Path) -> None:
         "gauge_linearity": "gauge_linearity",
         "joint_troubleshooting": "joint_troubleshooting",
         "gain_schedule": "gain_schedule",
+        "pose_characteristics": "pose_characteristics",
     }
 
 

@@ -28,12 +28,15 @@ import numpy as np
 
 from station.errors import StationError
 from station.methods.contract import (
+    DemoDisplay,
+    DemoRig,
     Judgement,
     Method,
     MethodInputs,
     PlacementWords,
 )
 from station.methods.pose_characteristics.iso9283 import (
+    CYCLES,
     POSES,
     Conditions,
     PoseCharacteristics,
@@ -59,6 +62,7 @@ if TYPE_CHECKING:
     from _typeshed import SupportsWrite
 
     from station.analysis.summary import AnalysisConfig
+    from station.instruments.simulator import GaugeSpec
     from station.session.model import Session
     from station.session.tables import ReadingTable
 
@@ -172,6 +176,32 @@ def _readings(inputs: MethodInputs) -> PoseReadings:
     return session_readings(inputs.session)
 
 
+def _pose_display(model: Any, placement: int | None, unit: str) -> DemoDisplay | None:
+    """What the simulated teach pendant shows at pose ``placement``, or the conditions of the
+    simulated run before the first pose."""
+    if placement is None:
+        return DemoDisplay(
+            label="Test conditions (simulated)",
+            text="load 100 % of rated, speed 100 % of rated, warm-up 30 min, 20.5 °C at the "
+            "start, 21.0 °C at the end",
+            values={
+                "load": 100,
+                "speed": 100,
+                "warm_up": 30,
+                "temperature_start": 20.5,
+                "temperature_end": 21.0,
+            },
+            hint="type the conditions shown above",
+        )
+    shown = model.placement_of(placement)
+    return DemoDisplay(
+        label=f"Teach pendant at P{placement} (simulated)",
+        text=shown.pendant_text(unit),
+        values=dict(zip(AXES, shown.pendant, strict=True)),
+        hint="copy the simulated pendant's X, Y, Z shown above",
+    )
+
+
 class PoseCharacteristicsMethod(Method):
     """ISO 9283 pose accuracy, repeatability, vAP and distance at the test cube's poses."""
 
@@ -196,6 +226,7 @@ class PoseCharacteristicsMethod(Method):
         hint=f"the test cube's poses P1 to P{POSES}, one after the other ({{low}} to {{target}})",
         too_few=f"Give at least 1 pose; the standard measures P1 to P{POSES}.",
     )
+    demo_words = "one fixture taken to the five poses of the ISO 9283 test cube"
 
     def live(
         self, config: AnalysisConfig, channels: Sequence[str], header: Mapping[str, Any]
@@ -259,6 +290,19 @@ class PoseCharacteristicsMethod(Method):
                 cells += [number(v) for v in readings.commands[pose]]
             writer.writerow(cells)
         return len(poses)
+
+    def demo_rig(self, gauge: GaugeSpec, seed: int, *, stroke_points: int) -> DemoRig:
+        """One fixture at the five poses of a 20 in test cube, each pose with a bias and a
+        spread of its own, and the teach pendant's X, Y, Z of each."""
+        from station.instruments.simulator.cube import CubePosesModel
+
+        # Mitutoyo has no zero command: the station zeroes in software at the taught pose.
+        model = CubePosesModel(captures=CYCLES, preload=0.05, gauge=gauge, seed=seed)
+        return DemoRig(
+            model,
+            "one simulated fixture at the test cube's five poses and a teach pendant (seeded)",
+            display=_pose_display,
+        )
 
 
 @dataclass(frozen=True)
