@@ -69,6 +69,11 @@ class CubePosesModel(TwoFixtureModel):
         self.biases = tuple(tuple(float(v) for v in bias) for bias in biases)
         self.noises = tuple(float(v) for v in noises)
 
+    @property
+    def cycles(self) -> int:
+        """The returns per pose (what a demo that plays the robot steps through)."""
+        return self.captures
+
     def _index(self, number: int) -> int:
         if number < 1:
             raise StationError(f"poses are numbered from 1, not {number}.")
