@@ -39,6 +39,7 @@ import numpy as np
 from station.analysis.report import decimals_for, signed, unsigned
 from station.analysis.spatial import AXES, Spatial, spatial_figures
 from station.errors import StationError
+from station.plain import plain
 
 Point = tuple[float, float, float]
 
@@ -90,12 +91,13 @@ def parse_distance(text: str) -> DistanceSpec:
     """``P2:P4=27.71`` (or ``P2:P4``, the distance then from the two command poses) as a
     :class:`DistanceSpec`; StationError saying how to write it."""
     match = _DISTANCE.match(str(text))
+    shown = repr(plain(text, limit=40))
     example = "write e.g. P2:P4=27.71 (the known distance between P2 and P4)"
     if match is None:
-        raise StationError(f"the distance {str(text)[:40]!r} is not POSE:POSE=D; {example}.")
+        raise StationError(f"the distance {shown} is not POSE:POSE=D; {example}.")
     a, b = int(match.group(1)), int(match.group(2))
     if a == b or a < 1 or b < 1:
-        raise StationError(f"the distance {text!r} needs two different poses; {example}.")
+        raise StationError(f"the distance {shown} needs two different poses; {example}.")
     command = None
     if match.group(3) is not None:
         try:
@@ -104,8 +106,8 @@ def parse_distance(text: str) -> DistanceSpec:
             command = math.nan
         if not (math.isfinite(command) and command > 0):
             raise StationError(
-                f"the distance {text!r}: {match.group(3)!r} is not a length greater than 0; "
-                f"{example}."
+                f"the distance {shown}: {plain(match.group(3), limit=20)!r} is not a length "
+                f"greater than 0; {example}."
             )
     return DistanceSpec(a, b, command)
 
