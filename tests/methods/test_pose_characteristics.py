@@ -211,7 +211,11 @@ def test_the_report_says_which_clauses_were_measured_and_what_ap_is_relative_to(
     assert "Not measured: AD and RD (no distance between two poses was asked for); vAP" in text
     assert "drift of pose characteristics (§7.6" in text and "weaving" in text
     assert "AP at P1 is relative to the zero (no command pose)" in text
-    assert "\n  P1*   4  3.00  4.00  12.00  +3.00  +4.00  +12.00  13.00\n" in text
+    # No gauge step given: the one number format's six decimals, positions signed.
+    assert (
+        "\n  P1*   4  +3.000000  +4.000000  +12.000000  +3.000000  +4.000000  +12.000000  "
+        "13.000000\n" in text
+    )
     assert "  * relative to the zero" in text
 
 

@@ -36,10 +36,10 @@ from typing import Any
 
 import numpy as np
 
-from station.analysis.report import decimals_for, signed, unsigned
 from station.analysis.spatial import AXES, Spatial, spatial_figures
 from station.errors import StationError
 from station.plain import plain
+from station.text import format_figure, format_spread
 
 Point = tuple[float, float, float]
 
@@ -484,8 +484,6 @@ def report_lines(
 ) -> list[str]:
     """The report block: the clauses measured, per pose the barycentre, AP and RP, vAP, the
     distance, the conditions and how the run departs from the standard's."""
-    spread = max((p.spatial.l_mean or 0.0 for p in result.poses), default=0.0) or None
-    decimals = decimals_for(resolution, spread)
     shown = f" ({unit})" if unit else ""
     lines = [
         f"ISO 9283 POSE CHARACTERISTICS ({len(result.poses)} poses)",
@@ -498,9 +496,9 @@ def report_lines(
         [
             p.name + ("*" if p.ap_relative else ""),
             str(p.n),
-            *(unsigned(v, decimals) for v in p.barycentre),
-            *(signed(v, decimals) for v in p.ap_axes),
-            unsigned(p.ap, decimals),
+            *(format_figure(v, resolution) for v in p.barycentre),
+            *(format_figure(v, resolution) for v in p.ap_axes),
+            format_spread(p.ap, resolution),
         ]
         for p in result.poses
     ]
@@ -512,9 +510,9 @@ def report_lines(
         [
             p.name,
             str(p.n),
-            unsigned(p.spatial.l_mean, decimals),
-            unsigned(p.spatial.l_sd, decimals),
-            unsigned(p.spatial.rp, decimals),
+            format_spread(p.spatial.l_mean, resolution),
+            format_spread(p.spatial.l_sd, resolution),
+            format_spread(p.spatial.rp, resolution),
         ]
         for p in result.poses
     ]
@@ -527,20 +525,22 @@ def report_lines(
     for m in result.multidirectional:
         counts = ", ".join(f"{m.counts[d]} from direction {d}" for d in m.counts)
         lines.append(
-            f"  vAP at {pose_name(m.number)}: {unsigned(m.vap, decimals)}{unit and ' ' + unit} "
+            f"  vAP at {pose_name(m.number)}: "
+            f"{format_spread(m.vap, resolution)}{unit and ' ' + unit} "
             f"(largest distance between the directions' barycentres; {counts})"
         )
     d = result.distance
     if d is not None:
         pair = f"{pose_name(d.pose_a)} to {pose_name(d.pose_b)}"
-        rd = "-" if d.rd is None else "±" + unsigned(d.rd, decimals)
+        rd = "-" if d.rd is None else "±" + format_spread(d.rd, resolution)
         lines.append(
-            f"  Distance {pair} over {d.n} cycles: D-bar {unsigned(d.d_mean, decimals)}, D_c "
-            f"{unsigned(d.dc, decimals)} ({d.command_source}), AD {signed(d.ad, decimals)},"
+            f"  Distance {pair} over {d.n} cycles: D-bar {format_spread(d.d_mean, resolution)}, "
+            f"D_c {format_spread(d.dc, resolution)} ({d.command_source}), "
+            f"AD {format_figure(d.ad, resolution)},"
             f" RD {rd}{unit and ' ' + unit}"
         )
         if d.ad_axes is not None:
-            axes = ", ".join(signed(v, decimals) for v in d.ad_axes)
+            axes = ", ".join(format_figure(v, resolution) for v in d.ad_axes)
             lines.append(f"    AD per axis x, y, z: {axes}")
     lines += ["", *condition_lines(conditions)]
     gaps = departures(result, conditions)
