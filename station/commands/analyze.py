@@ -30,6 +30,7 @@ OPTION_FLAGS = {
     "tolerance": "--tolerance",
     "process_variation": "--process-variation",
     "pool_above": "--pool-above",
+    "distance": "--distance",
 }
 """The command line's values a method's analysis may take (its ``options``), by flag."""
 SUBGROUP_LIMIT = 1000
@@ -64,9 +65,12 @@ value (part and appraiser may be names) and gives the crossed Gage R&R by ANOVA
 and by average and range, %GRR against --tolerance T when given, ndc, and
 AIAG's verdict; --procedure positioning reads target, direction (up/down or
 +/-), actual or deviation and an optional cycle, and gives the ISO 230-2
-figures of one axis (B, R, E, M, A, up, down and both). A session file is
-analysed as its procedure declares (its `analysis`) unless --procedure says
-otherwise.
+figures of one axis (B, R, E, M, A, up, down and both); --procedure
+pose_characteristics reads cycle, x, y, z and optionally pose (1 = P1 ...),
+direction and the command pose cx, cy, cz, and gives the ISO 9283 barycentre,
+AP and RP per pose, vAP, and with --distance P2:P4=D the distance accuracy AD
+and repeatability RD. A session file is analysed as its procedure declares
+(its `analysis`) unless --procedure says otherwise.
 
 exit codes:
   0  analysed
@@ -163,6 +167,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--reference",
         metavar="X_M",
         help="gauge_check: the reference's known size (default: the session's, typed in)",
+    )
+    parser.add_argument(
+        "--distance",
+        metavar="PA:PB=D",
+        help="pose_characteristics: the two poses AD and RD are measured between and their "
+        "command distance D (without =D: from their command poses)",
     )
     parser.add_argument("--json", action="store_true", help="print one JSON document")
     parser.add_argument(
@@ -264,7 +274,7 @@ def table_times(table: Any, channels: dict[str, Any]) -> dict[str, Any] | None:
     return {name: table.times for name in channels}
 
 
-def method_options(method: Any, given: dict[str, float | None]) -> dict[str, float]:
+def method_options(method: Any, given: dict[str, float | str | None]) -> dict[str, float | str]:
     """The command line's values the method takes; StationError naming a flag it does not
     take (and the ones it does)."""
     from station.methods import methods
@@ -372,6 +382,7 @@ def run(args: argparse.Namespace) -> int:
             "reference": parse_number(args.reference, "--reference"),
             "tolerance": tolerance,
             "process_variation": variation,
+            "distance": args.distance,
         },
     )
     if isinstance(source, TableSource):

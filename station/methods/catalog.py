@@ -19,6 +19,7 @@ from station.methods.gauge_check import METHOD as GAUGE_CHECK
 from station.methods.gauge_linearity import METHOD as GAUGE_LINEARITY
 from station.methods.joint_troubleshooting import METHOD as JOINT_TROUBLESHOOTING
 from station.methods.linearity import METHOD as LINEARITY
+from station.methods.pose_characteristics import METHOD as POSE_CHARACTERISTICS
 from station.methods.positioning import METHOD as POSITIONING
 from station.methods.relative_accuracy import METHOD as RELATIVE_ACCURACY
 from station.methods.repeatability import METHOD as REPEATABILITY
@@ -35,6 +36,7 @@ BUILT_IN: tuple[Method, ...] = (
     JOINT_TROUBLESHOOTING,
     GAIN_SCHEDULE,
     POSITIONING,
+    POSE_CHARACTERISTICS,
 )
 """The station's own methods; the first is the default (a procedure that declares none and
 whose steps imply none)."""

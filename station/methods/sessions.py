@@ -129,6 +129,18 @@ def typed_per_placement(events: Sequence[Mapping[str, Any]]) -> dict[int, dict[s
     return typed
 
 
+def typed_points(
+    typed: Mapping[int, Mapping[str, Any]], fields: Sequence[str] = AXES
+) -> dict[int, tuple[float, ...]]:
+    """The point typed at each placement (the teach pendant's X, Y, Z: ``fields``) where every
+    one of its fields is a number; a placement missing one has no point."""
+    return {
+        placement: tuple(float(values[name]) for name in fields)
+        for placement, values in typed.items()
+        if all(is_number(values.get(name)) for name in fields)
+    }
+
+
 # -- placements ---------------------------------------------------------------------------------
 
 

@@ -42,6 +42,7 @@ PROCEDURES = (
     "joint_troubleshooting",
     "gain_schedule",
     "positioning",
+    "pose_characteristics",
 )
 
 

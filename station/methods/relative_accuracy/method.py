@@ -19,7 +19,7 @@ from station.methods.contract import (
     Method,
     MethodInputs,
 )
-from station.methods.sessions import AXES, is_number, placement_readings
+from station.methods.sessions import AXES, placement_readings, typed_points
 from station.methods.tables import export_comments, number
 from station.procedures import AnalysisNeeds
 from station.session.tables import require_columns
@@ -43,12 +43,7 @@ AccuracyInputs = tuple[np.ndarray, dict[str, np.ndarray], dict[int, tuple[float,
 def session_accuracy_inputs(session: Session) -> AccuracyInputs:
     """Placements, errors x, y, z and the pendant's coordinates typed per placement."""
     placements, errors, typed = placement_readings(session)
-    pendant = {
-        placement: tuple(float(values[axis]) for axis in AXES)
-        for placement, values in typed.items()
-        if all(is_number(values.get(axis)) for axis in AXES)
-    }
-    return placements, errors, pendant
+    return placements, errors, typed_points(typed)
 
 
 def table_accuracy_inputs(table: ReadingTable) -> AccuracyInputs:
