@@ -153,3 +153,30 @@ def test_bad_phase_settings_are_sentences():
         AnalysisConfig(freeze_after=1)
     with pytest.raises(StationError, match="center, ucl and lcl"):
         baseline_from_json({"limits": {"x": {"center": 0}}})
+
+
+class _CountedAlarms(tuple):
+    """A channel's live alarms that count how often they are walked through."""
+
+    walks = 0
+
+    def __iter__(self):
+        type(self).walks += 1
+        return super().__iter__()
+
+
+def test_alarms_are_judged_live_against_an_index_built_once():
+    """Judging every retrospective alarm live or not walks the live alarms once, not once per
+    alarm (a long periodic record has tens of thousands of each: that was quadratic), and
+    gives what comparing each alarm with every live alarm gives."""
+    channel = analyze_channel("x", drifting_with_outliers(n=200, seed=3), CONFIG)
+    live = channel.live_alarms
+    assert len(channel.alarms) > 20 and len(live) > 20
+    channel.__dict__["live_alarms"] = _CountedAlarms(live)
+    judged = [channel.alarm_is_live(alarm) for alarm in channel.alarms]
+    assert _CountedAlarms.walks == 1
+    assert judged == [
+        any(a.rule == alarm.rule and set(a.cycles) & set(alarm.cycles) for a in live)
+        for alarm in channel.alarms
+    ]
+    assert any(judged) and not all(judged)
