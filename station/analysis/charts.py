@@ -25,6 +25,7 @@ from typing import SupportsIndex
 
 import numpy as np
 
+from station.analysis.column import Column
 from station.analysis.constants import SIGMA_MULTIPLE, c4, chart_factors, d2
 from station.analysis.descriptive import as_readings
 from station.errors import StationError
@@ -52,9 +53,10 @@ class ControlChart:
     ucl: float | None
     lcl: float | None
     sigma_within: float | None
-    points: tuple[float, ...]
+    points: Column
+    """The plotted points in order: one array, read as a sequence of floats."""
     dispersion: Limits
-    dispersion_points: tuple[float, ...]
+    dispersion_points: Column
     message: str | None
 
     @property
@@ -199,9 +201,9 @@ def control_chart(
             ucl=None,
             lcl=None,
             sigma_within=None,
-            points=(),
+            points=Column(()),
             dispersion=Limits(None, None, None),
-            dispersion_points=(),
+            dispersion_points=Column(()),
             message=message,
         )
     spreads, spread, sigma = found
@@ -218,8 +220,8 @@ def control_chart(
         ucl=center + half_width,
         lcl=center - half_width,
         sigma_within=sigma,
-        points=tuple(means.tolist()),
+        points=Column(means),
         dispersion=Limits(spread, upper * spread, lower * spread),
-        dispersion_points=tuple(spreads.tolist()),
+        dispersion_points=Column(spreads),
         message=_left_out(array.size % size, size),
     )

@@ -62,15 +62,13 @@ from station.analysis.phases import (
     ewma_alarm,
     ewma_alarms,
 )
-from station.analysis.rules import Alarm, check_rules
+from station.analysis.rules import Alarm, PointCycles, check_rules
 from station.analysis.summary import (
     Analysis,
     AnalysisConfig,
     ChannelAnalysis,
-    PointCycles,
     analyze_channel,
     combine,
-    point_cycles,
 )
 from station.errors import StationError
 
@@ -356,7 +354,7 @@ class LiveChannel:
         newest = len(self._points)
         first = newest - len(tail) + 1
         # The cycles behind the tail's points only: O(RULE_WINDOW · subgroup), not O(n).
-        behind = point_cycles(
+        behind = PointCycles(
             self._cycles[(first - 1) * self._subgroup :], self._subgroup, len(tail)
         )
         alarms = check_rules(
@@ -399,7 +397,7 @@ class LiveChannel:
     def _point_labels(self, first: int) -> PointCycles:
         """Cycles behind the chart points from number ``first`` (1-based) on."""
         count = len(self._points) - first + 1
-        return point_cycles(self._cycles[(first - 1) * self._subgroup :], self._subgroup, count)
+        return PointCycles(self._cycles[(first - 1) * self._subgroup :], self._subgroup, count)
 
     def _catch_up(self) -> tuple[Alarm, ...]:
         frozen = self._frozen
@@ -453,12 +451,12 @@ class LiveChannel:
             self._ewma_side = side
             if self._ewma_run_start is None:
                 self._ewma_run_start = newest
-            run = list(range(self._ewma_run_start, newest + 1))
+            run = range(self._ewma_run_start, newest + 1)
             labels = self._point_labels(self._ewma_run_start)
             found.append(
                 ewma_alarm(
                     run,
-                    [labels[p - run[0]] for p in run],
+                    labels.span(0, len(run) - 1),
                     self._ewma,
                     half,
                     frozen,

@@ -16,14 +16,21 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from station.analysis.constants import SIGMA_MULTIPLE
-from station.analysis.diagnostics import EWMA_LAMBDA, EWMA_WIDTH, ewma_values
-from station.analysis.rules import Alarm, check_rules, number_list
+from station.analysis.diagnostics import (
+    EWMA_LAMBDA,
+    EWMA_WIDTH,
+    ewma_limit_half_widths,
+    ewma_values,
+)
+from station.analysis.rules import Alarm, PointCycles, check_rules, cycle_subject, flag_runs
 from station.errors import StationError
 from station.text import format_figure
+
+if TYPE_CHECKING:
+    import numpy as np
 
 #: Chart points after which the live limits freeze when the procedure names no minimum count.
 DEFAULT_FREEZE_AFTER = 20
@@ -88,40 +95,55 @@ class EwmaAlarms:
 
 def ewma_alarm(
     points: Sequence[int],
-    cycles: Sequence[Sequence[int]],
+    cycles: tuple[int, ...],
     value: float,
     half_width: float,
     frozen: FrozenLimits,
     unit: str | None,
     resolution: float | None = None,
 ) -> Alarm:
-    """One EWMA alarm over consecutive flagged ``points`` (1-based)."""
-    labels = tuple(sorted({int(c) for group in cycles for c in group}))
-    above = value > frozen.center
-    limit = frozen.center + (half_width if above else -half_width)
-    # Written as every figure (one decimal beyond the gauge step), as the run-rule sentences.
-    ewma_text = format_figure(value, resolution, unit=unit or "")
-    limit_text = format_figure(limit, resolution, unit=unit or "")
-    where = (
-        f"{'Cycle' if len(labels) == 1 else 'Cycles'} {number_list(labels)}"
-        if labels
-        else f"Point {points[-1]}"
-    )
-    return Alarm(
-        "ewma",
-        tuple(points),
-        f"{where}: the EWMA ({ewma_text}) is {'above' if above else 'below'} "
-        f"its {'upper' if above else 'lower'} limit ({limit_text}): the mean is "
-        f"drifting {'up' if above else 'down'}; let the robot warm up, look for a loose fixture or "
-        "gauge, and repeat.",
-        labels,
-    )
+    """One EWMA alarm over consecutive flagged ``points`` (1-based), with the cycles behind
+    them (ascending, each once; empty when unknown) and the EWMA ``value`` and limit
+    ``half_width`` at its last point. Its sentence is written when read."""
+    sentence = _EwmaSentence(frozen, unit, (value,), (half_width,), points[-1], resolution)
+    return Alarm("ewma", tuple(points), sentence, cycles)
+
+
+@dataclass(frozen=True)
+class _EwmaSentence:
+    """Writes the sentence of an EWMA alarm from its points and cycles: the EWMA and its limit
+    at the alarm's last point are ``values`` and ``half_widths`` from point ``first_point`` on
+    (one writer serves every alarm of a chart)."""
+
+    frozen: FrozenLimits
+    unit: str | None
+    values: Sequence[float] | np.ndarray
+    half_widths: Sequence[float] | np.ndarray
+    first_point: int
+    resolution: float | None = None
+
+    def __call__(self, alarm: Alarm) -> str:
+        frozen, unit = self.frozen, self.unit
+        at = alarm.points[-1] - self.first_point
+        value, half_width = float(self.values[at]), float(self.half_widths[at])
+        above = value > frozen.center
+        limit = frozen.center + (half_width if above else -half_width)
+        # Written as every figure (one decimal beyond the gauge step), as the run-rule sentences.
+        ewma_text = format_figure(value, self.resolution, unit=unit or "")
+        limit_text = format_figure(limit, self.resolution, unit=unit or "")
+        where = cycle_subject(alarm.cycles) if alarm.cycles else f"Point {alarm.points[-1]}"
+        return (
+            f"{where}: the EWMA ({ewma_text}) is {'above' if above else 'below'} "
+            f"its {'upper' if above else 'lower'} limit ({limit_text}): the mean "
+            f"is drifting {'up' if above else 'down'}; let the robot warm up, look for a loose "
+            "fixture or gauge, and repeat."
+        )
 
 
 def ewma_alarms(
-    points: Sequence[float],
+    points: Sequence[float] | np.ndarray,
     frozen: FrozenLimits,
-    cycles: Sequence[Sequence[int]],
+    cycles: PointCycles,
     *,
     unit: str | None = None,
     resolution: float | None = None,
@@ -134,45 +156,27 @@ def ewma_alarms(
     if not len(points):
         return EwmaAlarms((), None, None, 0)
     z = ewma_values(points, frozen.center, lam)
-    index = np.arange(1, z.size + 1)
-    half = width * frozen.point_sigma * np.sqrt(lam / (2 - lam) * (1 - (1 - lam) ** (2 * index)))
-    found: list[tuple[int, Alarm]] = []
+    half = ewma_limit_half_widths(frozen.point_sigma, z.size, lam, width)
+    sentence = _EwmaSentence(frozen, unit, z, half, 1, resolution)
+    found: list[Alarm] = []
     run_start, side = None, 0
     for direction, flags in ((1, z - frozen.center > half), (-1, frozen.center - z > half)):
-        for run in _runs(np.flatnonzero(flags)):
-            last = run[-1] - 1
-            alarm = ewma_alarm(
-                run,
-                [cycles[p - 1] for p in run],
-                float(z[last]),
-                float(half[last]),
-                frozen,
-                unit,
-                resolution,
+        for first, last in flag_runs(flags):
+            found.append(
+                Alarm("ewma", tuple(range(first + 1, last + 2)), sentence, cycles.span(first, last))
             )
-            found.append((run[0], alarm))
-            if run[-1] == z.size:
-                run_start, side = run[0], direction
-    found.sort(key=lambda item: item[0])
-    return EwmaAlarms(tuple(a for _, a in found), float(z[-1]), run_start, side)
-
-
-def _runs(indices: np.ndarray) -> list[list[int]]:
-    """Sorted 0-based indices as runs of consecutive 1-based point numbers."""
-    runs: list[list[int]] = []
-    for i in indices.tolist():
-        if runs and runs[-1][-1] == i:
-            runs[-1].append(i + 1)
-        else:
-            runs.append([i + 1])
-    return runs
+            if last + 1 == z.size:
+                run_start, side = first + 1, direction
+    # Runs above and below never share a point: ordered by first point, as the chart reads.
+    found.sort(key=lambda alarm: alarm.points[0])
+    return EwmaAlarms(tuple(found), float(z[-1]), run_start, side)
 
 
 def phase_two_alarms(
-    points: Sequence[float],
+    points: Sequence[float] | np.ndarray,
     frozen: FrozenLimits,
     rule_set: str,
-    cycles: Sequence[Sequence[int]],
+    cycles: PointCycles,
     *,
     unit: str | None = None,
     resolution: float | None = None,

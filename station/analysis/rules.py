@@ -37,7 +37,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import FrozenInstanceError, dataclass
+from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
@@ -48,16 +50,121 @@ from station.text import format_figure
 RULE_SETS: tuple[str, ...] = ("report", "western-electric", "nelson")
 
 
-@dataclass(frozen=True)
 class Alarm:
     """One signal: the rule id (``"report-1"``, ``"we-2"``, ``"nelson-7"``), the flagged points
-    (1-based, in order) and a sentence saying what was seen and where to look."""
+    (1-based, in order), a sentence saying what was seen and where to look (``text``), and the
+    cycle numbers behind the flagged points, ascending (``cycles``; empty when the caller gave
+    none).
+
+    ``text`` may be given as a function that writes the sentence from the alarm itself (its
+    points and cycles): it is called the first time the sentence is read. A long record raises
+    tens of thousands of alarms and most are counted, not read; writing each sentence up front
+    cost more than finding them, and one writer serves every alarm of a rule.
+    Immutable; equal when rule, points, cycles and sentence are.
+    """
+
+    __slots__ = ("rule", "points", "cycles", "_text")
 
     rule: str
     points: tuple[int, ...]
-    text: str
-    cycles: tuple[int, ...] = ()
-    """The cycle numbers behind the flagged points, ascending (empty when the caller gave none)."""
+    cycles: tuple[int, ...]
+    _text: str | Callable[[Alarm], str]
+
+    def __init__(
+        self,
+        rule: str,
+        points: tuple[int, ...],
+        text: str | Callable[[Alarm], str],
+        cycles: tuple[int, ...] = (),
+    ) -> None:
+        object.__setattr__(self, "rule", rule)
+        object.__setattr__(self, "points", points)
+        object.__setattr__(self, "cycles", cycles)
+        object.__setattr__(self, "_text", text)
+
+    @property
+    def text(self) -> str:
+        """The sentence for the technician (written on first use when it was deferred)."""
+        text = self._text
+        if not isinstance(text, str):
+            text = text(self)
+            object.__setattr__(self, "_text", text)
+        return text
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise FrozenInstanceError(f"cannot assign to field {name!r}")
+
+    def __delattr__(self, name: str) -> None:
+        raise FrozenInstanceError(f"cannot delete field {name!r}")
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Alarm):
+            return NotImplemented
+        return (self.rule, self.points, self.cycles) == (
+            other.rule,
+            other.points,
+            other.cycles,
+        ) and self.text == other.text
+
+    def __hash__(self) -> int:
+        return hash((self.rule, self.points, self.cycles))
+
+    def __repr__(self) -> str:
+        return (
+            f"Alarm(rule={self.rule!r}, points={self.points!r}, text={self.text!r}, "
+            f"cycles={self.cycles!r})"
+        )
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (Alarm, (self.rule, self.points, self.text, self.cycles))
+
+
+class PointCycles(Sequence[tuple[int, ...]]):
+    """The cycle numbers behind each of the first ``points`` chart points: one cycle per point
+    for single readings, the ``subgroup`` consecutive cycles of each subgroup mean.
+
+    Kept as one array and looked up on demand: the rules look up only the points of their
+    alarms, and building a tuple per point of a million-point chart cost more than the rules
+    themselves.
+    """
+
+    def __init__(self, cycles: Sequence[int] | np.ndarray, subgroup: int, points: int) -> None:
+        self._cycles = np.asarray(cycles, dtype=np.int64)
+        self.subgroup = subgroup
+        self._points = points
+        self._ascending: bool | None = None
+
+    def __len__(self) -> int:
+        return self._points
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(self._points))]
+        if index < 0:
+            index += self._points
+        if not 0 <= index < self._points:
+            raise IndexError(index)
+        start = index * self.subgroup
+        return tuple(self._cycles[start : start + self.subgroup].tolist())
+
+    def span(self, first: int, last: int) -> tuple[int, ...]:
+        """The cycles behind points ``first`` to ``last`` (0-based, inclusive), ascending and
+        each once: a slice of the array when the cycles ascend, as a record's do."""
+        if self._ascending is None:
+            self._ascending = bool(np.all(np.diff(self._cycles) > 0))
+        chunk = self._cycles[first * self.subgroup : (last + 1) * self.subgroup].tolist()
+        return tuple(chunk) if self._ascending else tuple(sorted(set(chunk)))
+
+
+def flag_runs(flags: np.ndarray) -> list[tuple[int, int]]:
+    """The runs of consecutive True items of ``flags``: (first, last) 0-based, inclusive."""
+    index = np.flatnonzero(flags)
+    if not index.size:
+        return []
+    breaks = np.flatnonzero(np.diff(index) != 1)
+    starts = index[np.concatenate(([0], breaks + 1))]
+    ends = index[np.concatenate((breaks, [index.size - 1]))]
+    return list(zip(starts.tolist(), ends.tolist(), strict=True))
 
 
 # A rule's flags: one boolean array per direction (+1 above/rising, -1 below/falling, 0 none).
@@ -360,6 +467,7 @@ RULE_NAMES: dict[str, str] = {
 _SET_WORDS = {"report": "report rule", "we": "Western Electric rule", "nelson": "Nelson rule"}
 
 
+@lru_cache(maxsize=256)
 def rule_name(rule_id: str) -> str:
     """A rule id in words: ``report-1`` → "report rule 1 (a point beyond the control limits)";
     an unknown id is returned as it is."""
@@ -384,12 +492,13 @@ def _formatter(resolution: float | None, unit: str | None) -> Formatter:
     return lambda value: format_figure(value, resolution, unit=unit or "")
 
 
-def _subject(points: list[int]) -> str:
-    if len(points) == 1:
-        return f"Point {points[0]}"
-    if len(points) == 2:
-        return f"Points {points[0]} and {points[1]}"
-    return f"Points {points[0]} to {points[-1]}"
+def _subject(first: int, last: int) -> str:
+    """``Point 7``, ``Points 7 and 8``, ``Points 7 to 12``: a run of points by its ends."""
+    if last == first:
+        return f"Point {first}"
+    if last == first + 1:
+        return f"Points {first} and {last}"
+    return f"Points {first} to {last}"
 
 
 def number_list(numbers: Sequence[int]) -> str:
@@ -410,19 +519,46 @@ def number_list(numbers: Sequence[int]) -> str:
     return parts[0] if len(parts) == 1 else ", ".join(parts[:-1]) + " and " + parts[-1]
 
 
-def _cycle_subject(cycles: Sequence[int]) -> str:
-    return f"{'Cycle' if len(cycles) == 1 else 'Cycles'} {number_list(cycles)}"
+def cycle_subject(cycles: Sequence[int]) -> str:
+    """``Cycle 7``, ``Cycles 7 and 9``, ``Cycles 2, 4 to 6 and 8``: cycles ascending, each once."""
+    word = "Cycle" if len(cycles) == 1 else "Cycles"
+    if cycles[-1] - cycles[0] == len(cycles) - 1:
+        # Consecutive (each once, ascending): the list in words needs no walk through them.
+        if len(cycles) >= 3:
+            return f"{word} {cycles[0]} to {cycles[-1]}"
+        if len(cycles) == 2:
+            return f"{word} {cycles[0]} and {cycles[1]}"
+        return f"{word} {cycles[0]}"
+    return f"{word} {number_list(cycles)}"
 
 
-def _contiguous(indices: np.ndarray) -> list[list[int]]:
-    """Split sorted 0-based indices into runs of consecutive ones, as 1-based point numbers."""
-    groups: list[list[int]] = []
-    for index in indices.tolist():
-        if groups and groups[-1][-1] == index:  # previous 1-based number == this 0-based index
-            groups[-1].append(index + 1)
-        else:
-            groups.append([index + 1])
-    return groups
+def _cycles_behind(
+    cycles: Sequence[Sequence[int]], first: int, last: int
+) -> tuple[tuple[int, ...], bool]:
+    """The cycles behind points ``first`` to ``last`` (0-based) ascending, and whether every
+    point is one cycle (then the sentence names cycles)."""
+    if isinstance(cycles, PointCycles):
+        return cycles.span(first, last), cycles.subgroup == 1
+    behind = [cycles[i] for i in range(first, last + 1)]
+    labels = tuple(sorted({int(c) for group in behind for c in group}))
+    return labels, all(len(group) == 1 for group in behind)
+
+
+@dataclass(frozen=True)
+class _Sentence:
+    """Writes the sentence of any alarm of one rule on one side of the chart, from the alarm's
+    own points and cycles (naming the cycles when every point is one cycle)."""
+
+    kind: _Kind
+    side: int
+    ctx: _Context
+    fmt: Formatter
+    names_cycles: bool
+
+    def __call__(self, alarm: Alarm) -> str:
+        first, last = alarm.points[0], alarm.points[-1]
+        subject = cycle_subject(alarm.cycles) if self.names_cycles else _subject(first, last)
+        return self.kind.text(subject, last > first, self.side, self.ctx, self.fmt)
 
 
 def check_rules(
@@ -464,18 +600,27 @@ def check_rules(
         )
     ctx = _Context(values, float(center), float(sigma))
     fmt = _formatter(resolution, unit)
-    found: list[tuple[int, int, Alarm]] = []
+    found: list[Alarm] = []
+    keys: list[int] = []  # first point, then the rule's place in the set: the order shown
+    offset = first_point  # 0-based index in ``points`` → point number
     for order, (rule_id, kind) in enumerate(rules):
         for side, flags in kind.check(ctx).items():
-            for run in _contiguous(np.flatnonzero(flags) + (first_point - 1)):
+            # Sentences are written when read (see Alarm), by one writer per rule and side.
+            by_points = _Sentence(kind, side, ctx, fmt, names_cycles=False)
+            by_cycles = _Sentence(kind, side, ctx, fmt, names_cycles=True)
+            for start, end in flag_runs(flags):
                 labels: tuple[int, ...] = ()
-                subject = _subject(run)
+                single = False
                 if cycles is not None:
-                    behind = [cycles[p - first_point] for p in run]
-                    labels = tuple(sorted({int(c) for group in behind for c in group}))
-                    if all(len(group) == 1 for group in behind):
-                        subject = _cycle_subject(labels)
-                text = kind.text(subject, len(run) > 1, side, ctx, fmt)
-                found.append((run[0], order, Alarm(rule_id, tuple(run), text, labels)))
-    found.sort(key=lambda item: (item[0], item[1]))
-    return [alarm for _, _, alarm in found]
+                    labels, single = _cycles_behind(cycles, start, end)
+                first = start + offset
+                found.append(
+                    Alarm(
+                        rule_id,
+                        tuple(range(first, end + offset + 1)),
+                        by_cycles if single else by_points,
+                        labels,
+                    )
+                )
+                keys.append(first * len(rules) + order)
+    return [found[i] for i in np.argsort(keys, kind="stable").tolist()]

@@ -24,6 +24,7 @@ import numpy as np
 
 from station.analysis.capability import Capability, SpecLimits, capability
 from station.analysis.charts import ControlChart, control_chart
+from station.analysis.column import Column
 from station.analysis.descriptive import Descriptive, Histogram, describe, histogram
 from station.analysis.diagnostics import (
     Autocorrelation,
@@ -45,12 +46,14 @@ from station.analysis.phases import (
     FrozenLimits,
     phase_two_alarms,
 )
-from station.analysis.rules import RULE_SETS, Alarm, check_rules
+from station.analysis.rules import RULE_SETS, Alarm, PointCycles, check_rules
 from station.analysis.spatial import AXES, Spatial, find_axes, spatial_figures
 from station.analysis.verdict import DEFAULT_MIN_N, NOT_CAPABLE, Verdict, judge_verdict
 from station.errors import StationError
 
 NO_LIMITS_MESSAGE = "no specification limits: give limits for this channel"
+NO_CYCLES = Column((), dtype=np.int64)
+NO_TIMES = Column(())
 
 
 @dataclass(frozen=True)
@@ -128,10 +131,11 @@ class ChannelAnalysis:
     capability: Capability
     chart: ControlChart
     alarms: tuple[Alarm, ...]
-    readings: tuple[float, ...]
+    readings: Column
+    """The readings in order: one array, read as a sequence of floats."""
     limits: SpecLimits | None
     nominal: float
-    cycles: tuple[int, ...] = ()
+    cycles: Column = NO_CYCLES
     """The cycle number of each reading (same order); the alarms' ``cycles`` come from it."""
     verdict: Verdict | None = None
     """The verdict word (PROVISIONAL below ``config.min_n``) and its line."""
@@ -144,7 +148,8 @@ class ChannelAnalysis:
     phase_rules: tuple[str, str, int, float | None] = ("report", "", 1, None)
     """Rule set, unit, subgroup size and gauge resolution the live alarms are judged (and
     worded) with."""
-    times: tuple[float, ...] = ()
+    times: Column = NO_TIMES
+    """The time of each reading in seconds, when every reading has one (else empty)."""
 
     @cached_property
     def live_alarms(self) -> tuple[Alarm, ...]:
@@ -153,17 +158,17 @@ class ChannelAnalysis:
         if self.frozen is None:
             return ()
         rule_set, unit, size, resolution = self.phase_rules
-        values = np.asarray(self.readings, dtype=float)
+        values = self.readings.array
         complete = len(values) // size
         if not complete:
             return ()
         # The plotted points as the live analysis has them (a chart of one reading has none).
         points = values if size == 1 else values[: complete * size].reshape(complete, size).mean(1)
         return phase_two_alarms(
-            points.tolist(),
+            points,
             self.frozen,
             rule_set,
-            point_cycles(self.cycles, size, complete),
+            PointCycles(self.cycles, size, complete),
             unit=unit or None,
             resolution=resolution,
         )
@@ -175,7 +180,7 @@ class ChannelAnalysis:
         for every redraw of a live snapshot that does not show it."""
         if self.normality is None or not self.normality.rejected or self.limits is None:
             return None
-        return percentile_capability(self.readings, self.limits, self.capability.threshold)
+        return percentile_capability(self.readings.array, self.limits, self.capability.threshold)
 
     @property
     def capability_method(self) -> str:
@@ -262,56 +267,27 @@ def undefined_capability(
     )
 
 
-class PointCycles(Sequence[tuple[int, ...]]):
-    """The cycle numbers behind each of the first ``points`` chart points: one cycle per point
-    for single readings, the ``subgroup`` consecutive cycles of each subgroup mean.
-
-    Computed on demand: the rules look up only the points of their alarms, and building a
-    tuple per point of a million-point chart cost more than the rules themselves.
-    """
-
-    def __init__(self, cycles: Sequence[int], subgroup: int, points: int) -> None:
-        self._cycles = cycles
-        self._subgroup = subgroup
-        self._points = points
-
-    def __len__(self) -> int:
-        return self._points
-
-    def __getitem__(self, index):
-        if isinstance(index, slice):
-            return [self[i] for i in range(*index.indices(self._points))]
-        if index < 0:
-            index += self._points
-        if not 0 <= index < self._points:
-            raise IndexError(index)
-        start = index * self._subgroup
-        return tuple(self._cycles[start : start + self._subgroup])
-
-
-def point_cycles(cycles: Sequence[int], subgroup: int, points: int) -> PointCycles:
-    """The cycle numbers behind each of the first ``points`` chart points (see PointCycles)."""
-    return PointCycles(cycles, subgroup, points)
-
-
-def cycle_labels(name: str, cycles: Sequence[int] | None, n: int) -> tuple[int, ...]:
+def cycle_labels(name: str, cycles: Sequence[int] | np.ndarray | None, n: int) -> Column:
     """Checked cycle numbers for ``n`` readings of channel ``name``: 1 .. n when None."""
     if cycles is None:
-        return tuple(range(1, n + 1))
-    labels = tuple(int(c) for c in cycles)
-    if len(labels) != n or any(c != float(given) for c, given in zip(labels, cycles, strict=True)):
+        return Column(np.arange(1, n + 1), dtype=np.int64)
+    given = np.asarray(cycles)
+    whole = given.ndim == 1 and given.dtype.kind in "iuf"
+    if whole and given.dtype.kind == "f":
+        whole = bool(np.all(np.isfinite(given))) and bool(np.all(given == np.trunc(given)))
+    if not whole or len(given) != n:
         raise StationError(
-            f"channel {name!r} has {n} readings but {len(labels)} cycle numbers: give one whole "
+            f"channel {name!r} has {n} readings but {given.size} cycle numbers: give one whole "
             "cycle number per reading."
         )
-    return labels
+    return Column(given, dtype=np.int64)
 
 
 def chart_alarms(
     chart: ControlChart,
     rule_set: str,
     unit: str = "",
-    cycles: Sequence[int] | None = None,
+    cycles: Sequence[int] | np.ndarray | None = None,
     resolution: float | None = None,
 ) -> tuple[Alarm, ...]:
     """The run-rule alarms of a chart's location points, labelled by ``cycles`` (the cycle
@@ -327,13 +303,13 @@ def chart_alarms(
         cycles = range(1, len(chart.points) * chart.subgroup + 1)
     return tuple(
         check_rules(
-            chart.points,
+            chart.points.array,
             chart.center,
             sigma,
             rule_set,
             unit=unit or None,
             resolution=resolution,
-            cycles=point_cycles(cycles, chart.subgroup, len(chart.points)),
+            cycles=PointCycles(cycles, chart.subgroup, len(chart.points)),
         )
     )
 
@@ -381,6 +357,7 @@ def analyze_channel(
     (1, 2, 3 ... when None); ``times`` (seconds, one per reading) date them for the trend."""
     values = np.asarray(values, dtype=float)
     labels = cycle_labels(name, cycles, len(values))
+    label_array = labels.array
     limits = config.limits_for(name)
     descriptive = describe(values, config.resolution)
     hist = histogram(
@@ -403,17 +380,16 @@ def analyze_channel(
             sigma_within=chart.sigma_within,
         )
     normal = normality(values, config.resolution)
-    label_array = np.asarray(labels, dtype=int)
     frozen = frozen_limits_of(name, values, config)
-    clock = None if times is None or len(times) != len(values) else tuple(float(t) for t in times)
+    clock = None if times is None or len(times) != len(values) else Column(times)
     return ChannelAnalysis(
         name=name,
         descriptive=descriptive,
         histogram=hist,
         capability=cap,
         chart=chart,
-        alarms=chart_alarms(chart, config.rule_set, config.unit, labels, config.resolution),
-        readings=tuple(values.tolist()),
+        alarms=chart_alarms(chart, config.rule_set, config.unit, label_array, config.resolution),
+        readings=Column(values),
         limits=limits,
         nominal=config.nominal_for(name),
         cycles=labels,
@@ -424,7 +400,7 @@ def analyze_channel(
         drift=drift(
             values,
             chart.sigma_within,
-            times=clock,
+            times=None if clock is None else clock.array,
             cycles=label_array,
             name=name,
             unit=config.unit,
@@ -432,7 +408,7 @@ def analyze_channel(
         ),
         frozen=frozen,
         phase_rules=(config.rule_set, config.unit, config.subgroup, config.resolution),
-        times=clock or (),
+        times=clock or NO_TIMES,
     )
 
 
@@ -547,7 +523,7 @@ def combine(
     excluded_cycles: Sequence[int] = (),
 ) -> Analysis:
     """The Analysis of channels already analysed: adds the 3-D figures and the hints."""
-    readings = {name: np.asarray(c.readings, dtype=float) for name, c in channels.items()}
+    readings = {name: c.readings.array for name, c in channels.items()}
     return Analysis(
         channels=dict(channels),
         spatial=spatial_of(readings, config),

@@ -194,7 +194,7 @@ def read_table(path: str | Path, labels: Collection[str] = ()) -> ReadingTable:
                 _diagnose(handle, path, 0, names, skip_header=True, labels=label_positions)
             raise StationError(f"{plain(path)}: a cycle number is not 1, 2, 3 ...")
         cycles = numbers.astype(np.int64)
-    if info.st_size <= EXPORT_COMMENT_SCAN_LIMIT:
+    if info.st_size <= EXPORT_COMMENT_SCAN_LIMIT and _holds_a_hash(path):
         with open(path, encoding="utf-8-sig", newline="") as handle:
             comments = [
                 line.strip()[1:].strip() for line in handle if line.lstrip().startswith("#")
@@ -267,6 +267,17 @@ def _read_labelled(
     width = len(names) - len(label_positions)
     data = np.asarray(rows, dtype=np.float64).reshape(len(rows), width)
     return data, {names[i]: tuple(cells) for i, cells in labels.items()}, tuple(lines)
+
+
+def _holds_a_hash(path: Path, block: int = 1 << 20) -> bool:
+    """True when the file holds a ``#`` anywhere: only then can it have a comment line to
+    collect. Searching the bytes a block at a time costs a fraction of reading it line by
+    line, and most tables have no comment at all."""
+    with open(path, "rb") as raw:
+        while chunk := raw.read(block):
+            if b"#" in chunk:
+                return True
+    return False
 
 
 _REJECTED_COMMENT = re.compile(r"^rejected cycle (\d+)\b")

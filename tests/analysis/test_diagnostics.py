@@ -243,3 +243,17 @@ def test_rules_are_named_in_words():
     assert rule_name("we-4").startswith("Western Electric rule 4")
     assert rule_name("ewma") == "drift rule (the EWMA beyond its limits (a drift of the mean))"
     assert judge_verdict(capability([0.0, 0.0001, -0.0001], LIMITS), 25).word == "PROVISIONAL"
+
+
+def test_the_ewma_limits_of_a_long_chart_are_the_formula_at_every_point():
+    """The batch computes the start-up term (1 - lambda)^2i only while it can change a limit;
+    every limit is still exactly the formula's, and the live one's to rounding."""
+    from station.analysis.diagnostics import ewma_limit_half_width, ewma_limit_half_widths
+
+    for lam in (0.05, 0.2, 0.5, 1.0):
+        i = np.arange(1, 3001)
+        formula = 3.0 * 0.0003 * np.sqrt(lam / (2 - lam) * (1 - (1 - lam) ** (2 * i)))
+        batch = ewma_limit_half_widths(0.0003, 3000, lam, 3.0)
+        assert np.array_equal(batch, formula)
+        live = [ewma_limit_half_width(0.0003, k, lam, 3.0) for k in (1, 10, 3000)]
+        assert batch[[0, 9, 2999]] == pytest.approx(live, rel=1e-14)

@@ -139,3 +139,34 @@ def test_descriptions_are_one_line_each():
         "report-3",
         "report-4",
     ]
+
+
+def test_sentences_are_written_when_read_not_when_found(monkeypatch):
+    """A long record raises thousands of alarms; their sentences cost more than finding them,
+    so check_rules writes none, and each alarm writes its own once, when it is read."""
+    from station.analysis import rules
+
+    written = []
+    original = rules._Kind.text
+
+    def counted(self, *args):
+        written.append(args[0])
+        return original(self, *args)
+
+    monkeypatch.setattr(rules._Kind, "text", counted)
+    alarms = check_rules([3.5, -3.5] * 500, 0.0, 1.0, "nelson")
+    assert len(alarms) > 1000 and written == []
+    first = alarms[0].text
+    assert alarms[0].text == first and written == ["Point 1"]
+    assert first == (
+        "Point 1 is above the upper control limit (+3.000000): look for a cause at that cycle."
+    )
+
+
+def test_a_deferred_sentence_is_the_sentence_given_as_text():
+    (found,) = [a for a in check_rules([0.0, 3.5, 3.6], 0.0, 1.0, "report") if a.rule == "report-1"]
+    given = Alarm("report-1", (2, 3), found.text)
+    assert found == given and hash(found) == hash(given)
+    assert repr(found) == repr(given)
+    with pytest.raises(AttributeError):
+        found.rule = "report-2"  # type: ignore[misc]
