@@ -107,7 +107,9 @@ def modes_at_resolution(
         keys = np.floor(array / step + 0.5)
     else:
         keys = array
-    distinct, counts = np.unique(keys, return_counts=True)
+    distinct, counts = _counted_steps(keys) if resolution is not None else (None, None)
+    if distinct is None or counts is None:
+        distinct, counts = np.unique(keys, return_counts=True)
     highest = int(counts.max())
     if highest < 2:
         return ()
@@ -115,6 +117,19 @@ def modes_at_resolution(
     if resolution is None:
         return tuple(float(v) for v in tied)
     return tuple(step_multiple(int(k), step) for k in tied)
+
+
+def _counted_steps(keys: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """The distinct whole-step keys and their counts, ascending, by counting into one slot per
+    step (O(n)) when the readings span few steps, as a gauge's do; (None, None) when they span
+    too many (then sorting them is cheaper) or lie beyond exact integers."""
+    lowest, highest = float(keys.min()), float(keys.max())
+    span = highest - lowest
+    if max(abs(lowest), abs(highest)) >= 2**52 or span > 4 * keys.size + 1024:
+        return None, None
+    counts = np.bincount((keys - lowest).astype(np.int64), minlength=int(span) + 1)
+    present = np.flatnonzero(counts)
+    return present + lowest, counts[present]
 
 
 def step_multiple(k: int, step: float) -> float:

@@ -50,6 +50,9 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
 
 from station.analysis.capability import SpecLimits, capability_indices, cpk_lower_bound
 from station.analysis.charts import LARGEST_RANGE_SUBGROUP, chart_type
@@ -146,9 +149,12 @@ class LiveChannel:
         self._ewma: float | None = None
         self._ewma_run_start: int | None = None
         self._ewma_side = 0
-        self._values: list[float] = []
-        self._cycles: list[int] = []
-        self._times: list[float | None] = []
+        # The readings, their cycles and times: appended in O(1), handed to a snapshot without
+        # a copy (see _Growing).
+        self._values = _Growing(float)
+        self._cycles = _Growing(np.int64)
+        self._times = _Growing(float)
+        self._untimed = 0  # readings added without a time
         # Moments of the readings minus the first one: readings far from 0 (an indicator not
         # zeroed) would otherwise lose digits in the running mean.
         self._origin = 0.0
@@ -181,12 +187,12 @@ class LiveChannel:
     @property
     def values(self) -> list[float]:
         """A copy of the readings in the order they were added."""
-        return list(self._values)
+        return self._values.view().tolist()
 
     @property
     def cycles(self) -> list[int]:
         """A copy of the readings' cycle numbers, in the order they were added."""
-        return list(self._cycles)
+        return self._cycles.view().tolist()
 
     def add(self, value: float, cycle: int | None = None, t: float | None = None) -> LiveUpdate:
         """Add one reading (a finite number) of cycle number ``cycle`` (default: its position,
@@ -197,10 +203,11 @@ class LiveChannel:
             raise StationError(
                 f"{self.name}: reading {len(self._values) + 1} is not a finite number ({value!r})"
             )
-        previous = self._values[-1] if self._values else None
+        previous = self._values.last()
         self._values.append(x)
         self._cycles.append(len(self._values) if cycle is None else int(cycle))
-        self._times.append(None if t is None else float(t))
+        self._times.append(math.nan if t is None else float(t))
+        self._untimed += t is None
         self._snapshot = None
         n = len(self._values)
 
@@ -355,7 +362,7 @@ class LiveChannel:
         first = newest - len(tail) + 1
         # The cycles behind the tail's points only: O(RULE_WINDOW · subgroup), not O(n).
         behind = PointCycles(
-            self._cycles[(first - 1) * self._subgroup :], self._subgroup, len(tail)
+            self._cycles.view()[(first - 1) * self._subgroup :], self._subgroup, len(tail)
         )
         alarms = check_rules(
             tail,
@@ -397,7 +404,9 @@ class LiveChannel:
     def _point_labels(self, first: int) -> PointCycles:
         """Cycles behind the chart points from number ``first`` (1-based) on."""
         count = len(self._points) - first + 1
-        return PointCycles(self._cycles[(first - 1) * self._subgroup :], self._subgroup, count)
+        return PointCycles(
+            self._cycles.view()[(first - 1) * self._subgroup :], self._subgroup, count
+        )
 
     def _catch_up(self) -> tuple[Alarm, ...]:
         frozen = self._frozen
@@ -469,28 +478,58 @@ class LiveChannel:
         return tuple(found)
 
     def readings(self) -> ChannelReadings:
-        """A copy of the readings so far, to analyse later or on another thread (O(n) list
-        copies: no analysis)."""
-        times = None if None in self._times else tuple(self._times)
-        return ChannelReadings(self.name, tuple(self._values), tuple(self._cycles), times)  # type: ignore[arg-type]
+        """The readings so far, to analyse later or on another thread: O(1), views of arrays
+        that later readings do not change (no copy, no analysis)."""
+        times = None if self._untimed else self._times.view()
+        return ChannelReadings(self.name, self._values.view(), self._cycles.view(), times)
 
     def snapshot(self) -> ChannelAnalysis:
         """The full analysis of the readings so far: equal to the batch analysis (cached)."""
         if self._snapshot is None:
-            if not self._values:
+            if not len(self._values):
                 raise StationError(f"channel {self.name!r} has no readings yet.")
             self._snapshot = self.readings().analysis(self.config)
         return self._snapshot
 
 
-@dataclass(frozen=True)
+class _Growing:
+    """Numbers appended one at a time to an array that doubles when full (O(1) each, amortized).
+    :meth:`view` gives the numbers so far without a copy: later appends write past its end or
+    into a new array, so a view never changes once handed out."""
+
+    def __init__(self, dtype: Any) -> None:
+        self._array = np.empty(64, dtype=dtype)
+        self._size = 0
+
+    def append(self, value: float) -> None:
+        if self._size == self._array.size:
+            grown = np.empty(2 * self._array.size, dtype=self._array.dtype)
+            grown[: self._size] = self._array
+            self._array = grown
+        self._array[self._size] = value
+        self._size += 1
+
+    def last(self) -> float | None:
+        return float(self._array[self._size - 1]) if self._size else None
+
+    def view(self) -> np.ndarray:
+        view = self._array[: self._size]
+        view.flags.writeable = False
+        return view
+
+    def __len__(self) -> int:
+        return self._size
+
+
+@dataclass(frozen=True, eq=False)
 class ChannelReadings:
-    """One channel's readings at one moment of a live analysis, with their cycles and times."""
+    """One channel's readings at one moment of a live analysis, with their cycles and times
+    (read-only arrays; ``times`` None unless every reading has one)."""
 
     name: str
-    values: tuple[float, ...]
-    cycles: tuple[int, ...]
-    times: tuple[float, ...] | None
+    values: np.ndarray
+    cycles: np.ndarray
+    times: np.ndarray | None
 
     def analysis(self, config: AnalysisConfig) -> ChannelAnalysis:
         """The batch analysis of these readings (what :meth:`LiveChannel.snapshot` gives)."""

@@ -140,9 +140,6 @@ class ChannelAnalysis:
     verdict: Verdict | None = None
     """The verdict word (PROVISIONAL below ``config.min_n``) and its line."""
     out_of_spec: OutOfSpec | None = None
-    normality: Normality | None = None
-    autocorrelation: Autocorrelation | None = None
-    drift: Drift | None = None
     frozen: FrozenLimits | None = None
     """The phase II limits the live alarms are judged against (None: too few points yet)."""
     phase_rules: tuple[str, str, int, float | None] = ("report", "", 1, None)
@@ -150,6 +147,36 @@ class ChannelAnalysis:
     worded) with."""
     times: Column = NO_TIMES
     """The time of each reading in seconds, when every reading has one (else empty)."""
+    resolution: float | None = None
+    """The gauge step the readings were judged at (the normality test's ties, the drift's
+    figures)."""
+
+    # The checks of what the capability assumes are worked out on first use: tens of ms a
+    # channel (a test of normality sorts the readings), too much for every redraw of a live
+    # snapshot that does not show them.
+
+    @cached_property
+    def normality(self) -> Normality | None:
+        """Shapiro-Wilk or Anderson-Darling test of the readings."""
+        return normality(self.readings.array, self.resolution)
+
+    @cached_property
+    def autocorrelation(self) -> Autocorrelation | None:
+        """The lag-1 autocorrelation of the readings, against the within sigma."""
+        return autocorrelation(self.readings.array, sigma_within=self.chart.sigma_within)
+
+    @cached_property
+    def drift(self) -> Drift | None:
+        """The EWMA about the mean and the trend on the readings' times (else cycle order)."""
+        return drift(
+            self.readings.array,
+            self.chart.sigma_within,
+            times=self.times.array if len(self.times) else None,
+            cycles=self.cycles.array,
+            name=self.name,
+            unit=self.phase_rules[1],
+            resolution=self.resolution,
+        )
 
     @cached_property
     def live_alarms(self) -> tuple[Alarm, ...]:
@@ -379,7 +406,6 @@ def analyze_channel(
             # The chart's within sigma is the estimator capability() would compute again.
             sigma_within=chart.sigma_within,
         )
-    normal = normality(values, config.resolution)
     frozen = frozen_limits_of(name, values, config)
     clock = None if times is None or len(times) != len(values) else Column(times)
     return ChannelAnalysis(
@@ -395,20 +421,10 @@ def analyze_channel(
         cycles=labels,
         verdict=judge_verdict(cap, config.min_n),
         out_of_spec=out_of_spec(values, limits, label_array),
-        normality=normal,
-        autocorrelation=autocorrelation(values, sigma_within=chart.sigma_within),
-        drift=drift(
-            values,
-            chart.sigma_within,
-            times=None if clock is None else clock.array,
-            cycles=label_array,
-            name=name,
-            unit=config.unit,
-            resolution=config.resolution,
-        ),
         frozen=frozen,
         phase_rules=(config.rule_set, config.unit, config.subgroup, config.resolution),
         times=clock or NO_TIMES,
+        resolution=config.resolution,
     )
 
 
