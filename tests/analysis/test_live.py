@@ -238,3 +238,44 @@ def test_bad_readings_and_empty_snapshots_are_sentences():
         live.add(float("nan"))
     with pytest.raises(StationError, match="no readings yet"):
         LiveAnalysis(AnalysisConfig()).snapshot()
+
+
+def test_the_readings_a_snapshot_takes_are_views_no_later_reading_changes():
+    """The engine copies the live readings under its lock for every redraw: a view of arrays
+    that only grow costs nothing, and what it shows stays as it was."""
+    live = LiveChannel("x", AnalysisConfig())
+    for value in (0.1, 0.2, 0.3):
+        live.add(value, t=10.0 + value)
+    before = live.readings()
+    for value in np.linspace(0.4, 9.9, 200):  # enough to outgrow the first array
+        live.add(float(value), t=20.0)
+    after = live.readings()
+    assert before.values.tolist() == [0.1, 0.2, 0.3] and before.cycles.tolist() == [1, 2, 3]
+    assert before.times.tolist() == [10.1, 10.2, 10.3] and len(after.values) == 203
+    assert np.shares_memory(after.values, live.readings().values)
+    with pytest.raises(ValueError):
+        after.values[0] = 5.0
+    live.add(1.0)  # a reading without a time: the trend runs on cycle order
+    assert live.readings().times is None
+
+
+def test_a_snapshot_leaves_the_checks_it_does_not_show_until_asked(monkeypatch):
+    """A redraw shows the figures, the histogram and the chart: the test of normality (it sorts
+    every reading), the autocorrelation and the drift wait until something reads them."""
+    from station.analysis import summary
+
+    asked = []
+    for name in ("normality", "autocorrelation", "drift"):
+        original = getattr(summary, name)
+        monkeypatch.setattr(
+            summary, name, lambda *a, _f=original, _n=name, **k: asked.append(_n) or _f(*a, **k)
+        )
+    live = LiveChannel("x", AnalysisConfig(resolution=0.001))
+    for value in np.round(np.random.default_rng(2).normal(0.0, 0.01, 60), 3):
+        live.add(float(value))
+    channel = live.snapshot()
+    assert asked == [] and channel.descriptive.n == 60
+    batch = analyze_channel("x", live.values, AnalysisConfig(resolution=0.001))
+    assert channel.normality == batch.normality and channel.drift == batch.drift
+    assert channel.autocorrelation == batch.autocorrelation
+    assert sorted(set(asked)) == ["autocorrelation", "drift", "normality"]
