@@ -377,8 +377,8 @@ def analyze_channel(
     name: str,
     values: np.ndarray | Sequence[float],
     config: AnalysisConfig,
-    cycles: Sequence[int] | None = None,
-    times: Sequence[float] | None = None,
+    cycles: Sequence[int] | np.ndarray | None = None,
+    times: Sequence[float] | np.ndarray | None = None,
 ) -> ChannelAnalysis:
     """The full analysis of one channel's readings (in cycle order); ``cycles`` numbers them
     (1, 2, 3 ... when None); ``times`` (seconds, one per reading) date them for the trend."""
