@@ -85,7 +85,8 @@ class LiveUpdate:
 
     ``alarms`` are the rule alarms that flag the new point (its 1-based number is ``n`` for
     single readings; the subgroup's number when a subgroup was just completed), judged against
-    the limits as they stand now.
+    the limits as they stand now. An EWMA run that goes on is named by its last two points
+    (it was raised whole at its first).
     """
 
     channel: str
@@ -460,8 +461,12 @@ class LiveChannel:
             self._ewma_side = side
             if self._ewma_run_start is None:
                 self._ewma_run_start = newest
-            run = range(self._ewma_run_start, newest + 1)
-            labels = self._point_labels(self._ewma_run_start)
+            # A run goes on: it was raised, whole, at its first point (or when the limits froze).
+            # Named again whole it would cost O(run) a reading, quadratic over a long drift:
+            # its last two points say that it goes on (the ledger knows the earlier one) and
+            # flag the new one.
+            run = range(max(self._ewma_run_start, newest - 1), newest + 1)
+            labels = self._point_labels(run[0])
             found.append(
                 ewma_alarm(
                     run,

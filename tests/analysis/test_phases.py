@@ -180,3 +180,22 @@ def test_alarms_are_judged_live_against_an_index_built_once():
         for alarm in channel.alarms
     ]
     assert any(judged) and not all(judged)
+
+
+def test_a_long_drift_costs_the_same_at_every_reading_and_raises_one_ewma_alarm():
+    """Once the EWMA is beyond its limit it may stay there for thousands of readings: each
+    reading names the run by its last two points (O(1)), never the whole run again, and the
+    run is still one alarm, raised at its first point, flagging what the batch flags."""
+    rng = np.random.default_rng(4)
+    values = np.round(rng.normal(0.0, 0.0001, 600) + np.where(np.arange(600) < 30, 0, 0.0003), 5)
+    monitor = LiveMonitor(CONFIG, ["x"], freeze_after=20)
+    seen, raised = [], []
+    for cycle, value in enumerate(values, start=1):
+        updates, new = monitor.add_set({"x": float(value)}, cycle)
+        seen += updates["x"].alarms
+        raised += [a.alarm for a in new if a.alarm.rule == "ewma"]
+    ewma = [a for a in seen if a.rule == "ewma"]
+    assert len(ewma) > 500 and max(len(a.points) for a in ewma) == 2
+    assert len(raised) == 1 and len(raised[0].points) == 1  # raised at the run's first point
+    batch = analyze_channel("x", values, CONFIG)
+    assert flags(seen) == flags(batch.live_alarms)

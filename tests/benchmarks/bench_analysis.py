@@ -135,6 +135,29 @@ def bench_snapshot() -> None:
     )
 
 
+def bench_drift() -> None:
+    """A drift the EWMA catches and stays beyond for 20,000 readings (a robot warming up, limits
+    frozen early): a reading's CPU late in the run against early in it; about 1 is O(1)."""
+    from station.methods.live import LiveCycles
+
+    rng = np.random.default_rng(1990)
+    steps = np.where(np.arange(20_000) < 30, 0.0, 0.0003)
+    data = np.round(rng.normal(0.0, 0.0001, 20_000) + steps, 5).tolist()
+    config = AnalysisConfig(default_limits=LIMITS, resolution=0.00001)
+    live = LiveCycles(config, ("x",), {})
+    per_reading = []
+    for block in range(4):
+        start = time.process_time()
+        for cycle in range(block * 5000 + 1, (block + 1) * 5000 + 1):
+            live.add_cycle({"x": data[cycle - 1]}, cycle)
+        per_reading.append((time.process_time() - start) / 5000)
+    print(
+        f"LiveCycles.add_cycle in a 20,000-reading EWMA run: {per_reading[0] * 1e6:.0f} us per "
+        f"reading in the first 5,000, {per_reading[-1] * 1e6:.0f} us in the last 5,000 (CPU): "
+        f"x{per_reading[-1] / per_reading[0]:.2f} (about 1: O(1) per reading)"
+    )
+
+
 def bench_against_manufacturing() -> None:
     import manufacturing
     import manufacturing.analysis as theirs
@@ -180,4 +203,5 @@ if __name__ == "__main__":
     bench_batch()
     bench_live()
     bench_snapshot()
+    bench_drift()
     bench_against_manufacturing()
