@@ -171,6 +171,9 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
         # same at the 10 000th cycle as at the first.
         self._accepted_by_step: dict[tuple[str, int | None], int] = {}
         self._accepted_count = 0
+        self._rejected_cycles: tuple[int, ...] = ()
+        """The numbers of the rejected cycles, in order (kept on every reject: the live
+        analysis names them as excluded without a walk through every cycle)."""
         self._next_cycle = 1
         self._step_states: dict[tuple[str, int | None], dict[str, Any]] = {}
         self.recorded_zero: dict[str, dict[str, Any]] = {}
@@ -567,6 +570,7 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
         reject; on resume with the session's own record of what is not a cycle)."""
         self._accepted_by_step = {}
         accepted = [r for r in self._cycles if r.rejected is None]
+        self._rejected_cycles = tuple(r.cycle for r in self._cycles if r.rejected is not None)
         for record in accepted:
             key = (record.step_id, record.placement)
             self._accepted_by_step[key] = self._accepted_by_step.get(key, 0) + 1

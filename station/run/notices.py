@@ -89,7 +89,7 @@ class LiveNotices:
             if known is not None and known[0] == version:
                 return known[1:]
             copy = self._live.copy()
-            rejected = tuple(r.cycle for r in self._cycles if r.rejected is not None)
+            rejected = self._rejected_cycles
         problem = None
         try:
             analysis = copy.snapshot()
