@@ -125,14 +125,11 @@ def _decision_json(verdict: Verdict | None) -> dict[str, Any] | None:
 
 
 def _alarm_json(alarm: Alarm, live: bool) -> dict[str, Any]:
-    # The alarm's own tuples: json writes them as lists. A long record has a hundred thousand
-    # alarms, and two new lists each cost more (in the garbage collector's passes over them)
-    # than the rest of the document.
     return {
         "rule": alarm.rule,
         "rule_name": rule_name(alarm.rule),
-        "points": alarm.points,
-        "cycles": alarm.cycles,
+        "points": list(alarm.points),
+        "cycles": list(alarm.cycles),
         "text": alarm.text,
         "live": live,
     }
