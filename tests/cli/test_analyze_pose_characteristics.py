@@ -97,9 +97,10 @@ def test_the_text_report_says_what_was_measured(poses_csv: Path):
     assert "Measured: pose accuracy AP and pose repeatability RP (ISO 9283 §7.2) at P1, P2," in text
     assert "multi-directional pose accuracy variation vAP at P1" in text
     assert "distance accuracy AD and repeatability RD (§7.3) P2 to P3" in text
-    assert "vAP at P1: 5.00 mm" in text
+    # No gauge step given: the one number format's six decimals.
+    assert "vAP at P1: 5.000000 mm" in text
     # D_c from the two command poses, 10 apart: AD = 11 - 10.
-    assert "D-bar 11.00, D_c 10.00 (command poses), AD +1.00, RD ±3.00 mm" in text
+    assert "D-bar 11.000000, D_c 10.000000 (command poses), AD +1.000000, RD ±3.000000 mm" in text
     assert "Conditions: not recorded." in text
 
 

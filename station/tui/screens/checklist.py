@@ -110,7 +110,10 @@ class ChecklistScreen(Screen[None]):
 
     def show_state(self, state: RunnerState) -> None:
         """Redraw from a runner snapshot (UI thread)."""
-        self.query_one("#run-title", Static).update(_run_title(state))
+        titles = self.query("#run-title")
+        if not titles:
+            return  # its widgets are being taken down (the screen is leaving): nothing to draw
+        titles.first(Static).update(_run_title(state))
         self.query_one(StepList).show(state.steps)
         current = state.current
         key = (current.index, current.id) if current is not None else None
