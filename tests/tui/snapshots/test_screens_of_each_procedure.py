@@ -241,10 +241,11 @@ def test_relative_accuracy_pendant_step(snap_compare, lab, tui) -> None:
                 and screen.focused.id == "input-x"
                 and screen.focused.parent.has_class("-has-focus")
             ),
+            timeout=30.0,
         )
         panel = screen.query_one("#step-panel")
         last = screen.query("#step-inputs Input").last()
-        await tui.wait_until(pilot, lambda: panel.region.contains_region(last.region))
+        await tui.wait_until(pilot, lambda: panel.region.contains_region(last.region), timeout=30.0)
         await pilot.pause(0.3)
 
     app = _demo_app(lab, "relative_accuracy", 2)
