@@ -536,7 +536,9 @@ async def test_relative_accuracy_at_80x24_pendant_fields_instruction_and_capture
                 )
             await tui.wait_until(pilot, lambda: len(app.screen.query("#step-inputs Input")) == 3)
             # The first field takes the focus (once mounted: awaited, not slept for).
-            await tui.wait_until(pilot, lambda: getattr(app.screen.focused, "id", "") == "input-x")
+            await tui.wait_until(
+                pilot, lambda: getattr(app.screen.focused, "id", "") == "input-x", timeout=30.0
+            )
             await pilot.pause(0.1)
             panel = app.screen.query_one("#step-panel")
             shown = fixture.simulator.model.placement_of(app.runner.state().current.placement)

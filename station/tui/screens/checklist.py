@@ -199,7 +199,7 @@ class ChecklistScreen(Screen[None]):
         """Mark the focused field's row (its label in reverse video)."""
         mark_focused_row(self, event.widget)
 
-    def _focus_first_input(self, tries: int = 20) -> None:
+    def _focus_first_input(self, tries: int = 200) -> None:
         fields = self._step_fields()
         if not fields:
             # Not mounted yet (a busy terminal): look again after the next refresh, so the
