@@ -32,8 +32,7 @@ from station.text import (
     format_figure,
     format_index,
     format_spread,
-    judged_word,
-    overall_verdict,
+    overall_judgement,
 )
 
 SECONDS_PER_DAY = 86400.0
@@ -135,7 +134,7 @@ def _entry(path: Path, baseline_session: str | None) -> HistoryEntry:
             )
         if analysis.spatial is not None:
             rp = analysis.spatial.rp
-        verdict = overall_verdict(judged_word(c) for c in analysis.channels.values())
+        verdict = overall_judgement(analysis.channels.values())
     recorded = session.header.get("resolution")
     return HistoryEntry(
         path=path,

@@ -189,3 +189,13 @@ def test_history_names_each_file_it_could_not_read_in_one_line(sessions, capsys)
     ]
     assert all(s["error"] for s in document["skipped"])
     assert len(document["sessions"]) == 5
+
+
+def test_a_short_session_is_provisional_in_the_history_as_in_its_report(sessions, capsys):
+    """Fewer readings than the verdict needs: the history says PROVISIONAL with the count, as
+    the session's own report does, never UNDEFINED (which means no limits)."""
+    from station.analysis.verdict import DEFAULT_MIN_N
+
+    write_repeatability(sessions, robot="KSC-7", seed=4, cycles=DEFAULT_MIN_N - 5, reject=None)
+    (entry,) = robot_history(sessions, "KSC-7").entries
+    assert entry.verdict == f"PROVISIONAL: {DEFAULT_MIN_N - 5} of {DEFAULT_MIN_N}"
