@@ -44,8 +44,25 @@ async def wait_until(pilot, condition: Callable[[], object], timeout: float = 10
     deadline = time.monotonic() + timeout
     while not condition():
         if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting for {condition}")
+            raise AssertionError(
+                f"timed out after {timeout} s waiting for {condition}; {app_state(pilot.app)}"
+            )
         await pilot.pause(0.02)
+
+
+def app_state(app) -> str:
+    """What a failed wait saw: the screen stack, the focused widget and the runner's step
+    (a flake under load then says where it stood, not just that it timed out)."""
+    stack = " > ".join(type(screen).__name__ for screen in app.screen_stack)
+    focused = app.screen.focused
+    runner = getattr(app, "runner", None)
+    step = "no runner"
+    if runner is not None:
+        state = runner.state()
+        current = state.current
+        step = f"step {current.index} {current.kind}" if current is not None else "no step"
+        step += f", action {state.action.kind}"
+    return f"screens {stack}; focus {focused!r}; {step}"
 
 
 def key_event(key: str) -> events.Key:

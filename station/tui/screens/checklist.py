@@ -173,19 +173,30 @@ class ChecklistScreen(Screen[None]):
             action += " (Demo: the robot and the gauges are simulated; just press Enter.)"
         self.query_one("#step-action", Static).update(Text(action, style="bold cyan"))
         if todo is not None and todo.kind == "input":
+            rows = []
             for field in todo.fields:
                 unit = f" ({field.unit})" if field.unit else ""
-                row = Horizontal(
-                    Label(shown(f"{field.label}{unit}"), classes="field-label"),
-                    FieldInput(
-                        compact=True,
-                        id=f"input-{field.name}",
-                        type="number" if field.type == "number" else "text",
-                    ),
-                    classes="field-row",
+                rows.append(
+                    Horizontal(
+                        Label(shown(f"{field.label}{unit}"), classes="field-label"),
+                        FieldInput(
+                            compact=True,
+                            id=f"input-{field.name}",
+                            type="number" if field.type == "number" else "text",
+                        ),
+                        classes="field-row",
+                    )
                 )
-                inputs.mount(row)
-            self.call_after_refresh(self._focus_first_input)
+            self._mount_fields(inputs, rows)
+
+    @work(group="step-fields", exclusive=True, exit_on_error=False)
+    async def _mount_fields(self, inputs: Vertical, rows: list[Horizontal]) -> None:
+        """Mount an input step's rows and, once they (and the fields inside them) are in,
+        give the first field the focus: waiting for the mount itself, never a count of
+        refreshes, so a loaded terminal cannot leave the focus on the step list where the
+        first typed figures go nowhere."""
+        await inputs.mount_all(rows)
+        self._focus_first_input()
 
     def _demo_display(self, view: StepView) -> Any:
         """What the demo's simulated set-up shows at this step's placement (the teach
@@ -199,17 +210,12 @@ class ChecklistScreen(Screen[None]):
         """Mark the focused field's row (its label in reverse video)."""
         mark_focused_row(self, event.widget)
 
-    def _focus_first_input(self, tries: int = 200) -> None:
+    def _focus_first_input(self) -> None:
         fields = self._step_fields()
-        if not fields:
-            # Not mounted yet (a busy terminal): look again after the next refresh, so the
-            # focus never stays on the step list and the first typed figures go nowhere.
-            if tries:
-                self.call_after_refresh(self._focus_first_input, tries - 1)
-            return
-        if self.focused in fields:
-            return  # the operator is already in a field
-        fields[0].focus()
+        if not fields or self.focused in fields:
+            return  # the step moved on, or the operator is already in a field
+        # The screen's own set_focus, now (a widget's focus() would wait behind queued keys).
+        self.set_focus(fields[0])
         # All the fields in view at once (at 80×24 they sit below the step's text).
         self.query_one("#step-inputs").scroll_visible(animate=False)
 
