@@ -4,78 +4,23 @@ status read back from the dead pane (issue 13: the TUI exited 0 after SIGHUP/SIG
 from __future__ import annotations
 
 import os
-import shlex
+import re
 import shutil
 import signal
 import subprocess
 import sys
 import time
-import uuid
 from pathlib import Path
 
 import pytest
+
+from tests.e2e.terminal import Pane
 
 # End to end in a real terminal: slow by nature (the quick lane leaves them out).
 pytestmark = [
     pytest.mark.slow,
     pytest.mark.skipif(shutil.which("tmux") is None, reason="tmux is not installed"),
 ]
-
-
-def _tmux(*args: str) -> str:
-    return subprocess.run(["tmux", *args], capture_output=True, text=True, check=False).stdout
-
-
-class Pane:
-    """One detached tmux session that stays after its command exits (to read the status)."""
-
-    def __init__(self, command: list[str], cwd: Path, size: tuple[int, int] = (80, 24)) -> None:
-        self.name = f"station-op-{uuid.uuid4().hex[:8]}"
-        env = f"TERM=xterm-256color XDG_CONFIG_HOME={shlex.quote(os.environ['XDG_CONFIG_HOME'])}"
-        shell = f"cd {shlex.quote(str(cwd))} && {env} exec {shlex.join(command)}"
-        subprocess.run(
-            ["tmux", "new-session", "-d", "-s", self.name, "-x", str(size[0]), "-y", str(size[1])]
-            + [shell],
-            check=True,
-        )
-        _tmux("set-option", "-t", self.name, "remain-on-exit", "on")
-        self.pid = int(_tmux("display-message", "-p", "-t", self.name, "#{pane_pid}").strip())
-
-    def screen(self) -> str:
-        return _tmux("capture-pane", "-p", "-t", self.name)
-
-    def wait_for(self, text: str, timeout: float) -> str:
-        deadline = time.monotonic() + timeout
-        screen = ""
-        while time.monotonic() < deadline:
-            screen = self.screen()
-            if text in screen:
-                return screen
-            time.sleep(0.1)
-        pytest.fail(f"{text!r} did not appear within {timeout} s; the screen shows:\n{screen}")
-
-    def exit_status(self, timeout: float) -> int:
-        """The command's exit status once the pane is dead."""
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            fields = _tmux(
-                "display-message", "-p", "-t", self.name, "#{pane_dead} #{pane_dead_status}"
-            )
-            dead, _, status = fields.strip().partition(" ")
-            if dead == "1" and status:
-                return int(status)
-            time.sleep(0.1)
-        fields = _tmux(
-            "display-message",
-            "-p",
-            "-t",
-            self.name,
-            "dead=#{pane_dead} status=#{pane_dead_status} signal=#{pane_dead_signal}",
-        )
-        pytest.fail(f"station did not exit within {timeout} s ({fields}):\n{self.screen()}")
-
-    def close(self) -> None:
-        subprocess.run(["tmux", "kill-session", "-t", self.name], capture_output=True, check=False)
 
 
 class PtyProcess:
@@ -168,16 +113,16 @@ def test_the_stations_own_terminal_is_refused_as_a_gauge_line(tmp_path: Path) ->
     pane = Pane([sys.executable, "-m", "station", "--sessions", str(tmp_path)], tmp_path)
     try:
         pane.wait_for("New session", timeout=30)
-        tty = _tmux("display-message", "-p", "-t", pane.name, "#{pane_tty}").strip()
-        _tmux("send-keys", "-t", pane.name, "n")
-        pane.wait_for("Tab / Shift+Tab", timeout=30)
-        _tmux("send-keys", "-t", pane.name, "R1")
+        tty = pane.tty()
+        pane.send("n")
+        pane.wait_for(re.escape("Tab / Shift+Tab"), timeout=30)
+        pane.send("R1")
         for _ in range(10):  # robot → ... → the port field
-            _tmux("send-keys", "-t", pane.name, "Tab")
+            pane.send("Tab")
         pane.wait_for("Port", timeout=10)
-        _tmux("send-keys", "-t", pane.name, "-l", tty)
+        pane.send("-l", tty)
         time.sleep(0.5)
-        _tmux("send-keys", "-t", pane.name, "F3")
+        pane.send("F3")
         screen = pane.wait_for("own terminal", timeout=20)
         assert "Connected to" not in screen
     finally:

@@ -9,17 +9,16 @@ a short trial run of each procedure and reads the verdict words off the summary.
 from __future__ import annotations
 
 import json
-import os
 import re
-import shlex
 import shutil
 import subprocess
 import sys
 import time
-import uuid
 from pathlib import Path
 
 import pytest
+
+from tests.e2e.terminal import Pane, alive
 
 # End to end in a real terminal: slow by nature (the quick lane leaves them out).
 pytestmark = [
@@ -28,78 +27,6 @@ pytestmark = [
 ]
 
 ROOT = Path(__file__).resolve().parents[2]
-
-
-class Pane:
-    """One detached tmux session running one command at 80×24."""
-
-    def __init__(self, command: list[str], cwd: Path) -> None:
-        self.name = f"station-e2e-{uuid.uuid4().hex[:8]}"
-        env = {"TERM": "xterm-256color", "COLORTERM": "truecolor"}
-        # The pane's process starts in the tmux server's environment, which is the first
-        # test's that started the server: this test's own home and XDG folders (its signing
-        # key and trust store) go along explicitly.
-        env |= {
-            name: os.environ[name]
-            for name in (
-                "HOME",
-                "XDG_CONFIG_HOME",
-                "XDG_DATA_HOME",
-                "XDG_STATE_HOME",
-                "XDG_CACHE_HOME",
-            )
-            if name in os.environ
-        }
-        line = " ".join(f"{k}={shlex.quote(v)}" for k, v in env.items())
-        # `exec` so that the pane's process is station itself and receives the hang-up.
-        shell = f"cd {shlex.quote(str(cwd))} && {line} exec {shlex.join(command)}"
-        subprocess.run(
-            ["tmux", "new-session", "-d", "-s", self.name, "-x", "80", "-y", "24", shell],
-            check=True,
-        )
-        subprocess.run(["tmux", "set-option", "-t", self.name, "remain-on-exit", "on"], check=False)
-        self.pid = int(self._tmux("display-message", "-p", "-t", self.name, "#{pane_pid}"))
-
-    def _tmux(self, *args: str) -> str:
-        return subprocess.run(
-            ["tmux", *args], capture_output=True, text=True, check=False
-        ).stdout.strip()
-
-    def screen(self) -> str:
-        """What the 80×24 terminal shows now."""
-        return self._tmux("capture-pane", "-p", "-t", self.name)
-
-    def wait_for(self, text: str, timeout: float) -> str:
-        """The screen once it matches the regular expression ``text``; fails with the last
-        screen after ``timeout``."""
-        deadline = time.monotonic() + timeout
-        screen = ""
-        while time.monotonic() < deadline:
-            screen = self.screen()
-            if re.search(text, screen):
-                return screen
-            time.sleep(0.1)
-        pytest.fail(f"{text!r} did not appear within {timeout} s; the screen shows:\n{screen}")
-
-    def hang_up(self) -> None:
-        """Close the terminal: tmux sends SIGHUP to the pane's process."""
-        subprocess.run(["tmux", "kill-session", "-t", self.name], check=False)
-
-    def close(self) -> None:
-        """Kill the session if it is still there."""
-        subprocess.run(["tmux", "kill-session", "-t", self.name], capture_output=True, check=False)
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    # A zombie child of the tmux server counts as gone.
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z"
-    except OSError:
-        return False
 
 
 def _station(*args: str) -> list[str]:
@@ -114,9 +41,9 @@ def test_hang_up_during_capture_leaves_a_resumable_session(tmp_path: Path) -> No
         pane.wait_for(r"cycle ([2-9]|[12]\d) of 30", timeout=60)
         pane.hang_up()
         deadline = time.monotonic() + 15
-        while _alive(pane.pid) and time.monotonic() < deadline:
+        while alive(pane.pid) and time.monotonic() < deadline:
             time.sleep(0.1)
-        assert not _alive(pane.pid), "station did not exit on SIGHUP"
+        assert not alive(pane.pid), "station did not exit on SIGHUP"
     finally:
         pane.close()
 
@@ -142,9 +69,9 @@ def test_hang_up_during_capture_leaves_a_resumable_session(tmp_path: Path) -> No
     third = Pane(_station("demo", "--sessions", str(tmp_path)), tmp_path)
     try:
         third.wait_for("Resume:", timeout=30)
-        third._tmux("send-keys", "-t", third.name, "r")
+        third.send("r")
         third.wait_for("resumes on its own running simulator", timeout=30)
-        third._tmux("send-keys", "-t", third.name, "F2")
+        third.send("F2")
         deadline = time.monotonic() + 30
         while max(load_session(sessions[0], recover=False).cycles) == max(session.cycles):
             assert time.monotonic() < deadline, f"no cycle after the resume:\n{third.screen()}"
