@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 import pytest
-from helpers import STATION, start_simulator, stop_simulator
+from helpers import STATION, run_station, start_simulator, stop_simulator
 
 from station.instruments.simulator import BarModel
 from station.session.model import load_session
@@ -72,15 +72,13 @@ def capture(url: str, folder: Path, *extra: str) -> subprocess.Popen:
 
 
 def analyze_json(path: Path) -> dict:
-    done = subprocess.run(
-        [*STATION, "analyze", str(path), "--json"], capture_output=True, text=True, timeout=60
-    )
+    done = run_station("analyze", str(path), "--json")
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
 
 
 def verify(path: Path) -> None:
-    done = subprocess.run([*STATION, "verify", str(path)], capture_output=True, text=True)
+    done = run_station("verify", str(path))
     assert done.returncode == 0, done.stdout + done.stderr
 
 

@@ -11,7 +11,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from helpers import STATION, start_simulator, stop_simulator
+from helpers import STATION, run_station, start_simulator, stop_simulator
 
 from station.instruments.gauge_bench import GaugeBenchModel
 from station.instruments.joint_model import faulty_arm
@@ -100,13 +100,11 @@ def bench(protocol: str = "idh", bias: float = 0.0) -> Simulator:
 
 
 def gauges(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([*STATION, "gauges", *args], capture_output=True, text=True, timeout=60)
+    return run_station("gauges", *args)
 
 
 def analyze_json(path: Path) -> dict:
-    result = subprocess.run(
-        [*STATION, "analyze", str(path), "--json"], capture_output=True, text=True, timeout=60
-    )
+    result = run_station("analyze", str(path), "--json")
     assert result.returncode == 0, result.stderr
     return json.loads(result.stdout)
 
@@ -247,16 +245,21 @@ def test_a_gauge_linearity_study_headless_recovers_the_bench_slope(tmp_path: Pat
     assert load_register(other)["gauges"]["MIT-0042"]["studies"]["gauge_linearity"]
     # Its wide export is the table the study reads back, and gives the same figures.
     table = tmp_path / "study.csv"
-    exported = subprocess.run(
-        [*STATION, "export", str(path), "--csv", "-o", str(table)],
-        capture_output=True, text=True, timeout=60,
-    )  # fmt: skip
+    exported = run_station("export", str(path), "--csv", "-o", str(table))
     assert exported.returncode == 0, exported.stderr
-    again = subprocess.run(
-        [*STATION, "analyze", str(table), "--procedure", "gauge_linearity",
-         "--tolerance", "0.004", "--resolution", "0.0001", "--unit", "in", "--json"],
-        capture_output=True, text=True, timeout=60,
-    )  # fmt: skip
+    again = run_station(
+        "analyze",
+        str(table),
+        "--procedure",
+        "gauge_linearity",
+        "--tolerance",
+        "0.004",
+        "--resolution",
+        "0.0001",
+        "--unit",
+        "in",
+        "--json",
+    )
     assert again.returncode == 0, again.stderr
     assert json.loads(again.stdout)["gauge_linearity"]["slope"] == pytest.approx(study["slope"])
 
@@ -318,9 +321,7 @@ def test_gain_schedule_session_from_typed_gains(tmp_path: Path):
     assert len(document["positions"]) == 9
     assert "GAIN SCHEDULE REPORT ON" in summary and "GAIN SCHEDULE: 9 positions" in summary
     # The filed report of a session without a capability analysis: the fit under VERDICTS.
-    report = subprocess.run(
-        [*STATION, "report", str(path)], capture_output=True, text=True, timeout=60
-    )
+    report = run_station("report", str(path))
     assert report.returncode == 0, report.stderr
     assert "GAIN SCHEDULE: 9 positions" in report.stdout.split("VERDICTS", 1)[1]
 
@@ -353,13 +354,9 @@ def test_a_repeatability_session_says_which_gauge_check_covers_it(tmp_path: Path
     assert header["gauges"] == {"x": "MIT-0042"}
     assert header["gauge_checks"]["x"]["state"] == "passed"
     assert header["gauge_checks"]["z"]["state"] == "none"
-    analysed = subprocess.run(
-        [*STATION, "analyze", str(path)], capture_output=True, text=True, timeout=60
-    )
+    analysed = run_station("analyze", str(path))
     assert passed in analysed.stdout
-    report = subprocess.run(
-        [*STATION, "report", str(path)], capture_output=True, text=True, timeout=60
-    )
+    report = run_station("report", str(path))
     assert report.returncode == 0, report.stderr
     assert passed in report.stdout
 

@@ -7,11 +7,10 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
 from pathlib import Path
 
 import pytest
-from helpers import STATION
+from helpers import STATION, run_station
 
 from station.instruments.protocols import get_protocol
 from station.instruments.simulator import GaugeSpec, Simulator
@@ -26,9 +25,7 @@ RESOLUTION = 0.0001
 
 
 def analyze_json(*args: str | Path) -> dict:
-    done = subprocess.run(
-        [*STATION, "analyze", *map(str, args), "--json"], capture_output=True, text=True, timeout=60
-    )
+    done = run_station("analyze", *map(str, args), "--json")
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
 
@@ -116,10 +113,7 @@ def test_the_distance_between_two_poses_is_the_bias_along_their_line(session):
 def test_the_wide_export_reads_back_to_the_same_figures(session, tmp_path: Path):
     path, _, _ = session
     table = tmp_path / "poses.csv"
-    exported = subprocess.run(
-        [*STATION, "export", str(path), "--csv", "-o", str(table)],
-        capture_output=True, text=True, timeout=60,
-    )  # fmt: skip
+    exported = run_station("export", str(path), "--csv", "-o", str(table))  # fmt: skip
     assert exported.returncode == 0, exported.stderr
     header = next(line for line in table.read_text().splitlines() if not line.startswith("#"))
     assert header == "cycle,pose,direction,x,y,z,cx,cy,cz"

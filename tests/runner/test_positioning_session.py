@@ -8,11 +8,10 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
 from pathlib import Path
 
 import pytest
-from helpers import STATION
+from helpers import STATION, run_station
 
 from station.instruments.axis_model import AxisPositioningModel
 from station.instruments.protocols import get_protocol
@@ -33,10 +32,7 @@ RUNS = 5
 
 
 def analyze_json(path: Path, *args: str) -> dict:
-    done = subprocess.run(
-        [*STATION, "analyze", str(path), "--json", *args],
-        capture_output=True, text=True, timeout=60,
-    )  # fmt: skip
+    done = run_station("analyze", str(path), "--json", *args)  # fmt: skip
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
 
@@ -104,10 +100,7 @@ def test_the_injected_reversal_and_error_are_recovered(session: tuple[Path, str]
 def test_the_wide_export_is_the_table_the_analysis_reads(session: tuple[Path, str], tmp_path):
     path, _ = session
     table = tmp_path / "axis.csv"
-    exported = subprocess.run(
-        [*STATION, "export", str(path), "--csv", "-o", str(table)],
-        capture_output=True, text=True, timeout=60,
-    )  # fmt: skip
+    exported = run_station("export", str(path), "--csv", "-o", str(table))  # fmt: skip
     assert exported.returncode == 0, exported.stderr
     lines = [line for line in table.read_text().splitlines() if not line.startswith("#")]
     assert lines[0] == "target,direction,cycle,actual"
@@ -122,10 +115,7 @@ def test_the_wide_export_is_the_table_the_analysis_reads(session: tuple[Path, st
 def test_the_html_report_draws_the_deviations_up_and_down(session: tuple[Path, str], tmp_path):
     path, _ = session
     page = tmp_path / "report.html"
-    done = subprocess.run(
-        [*STATION, "report", str(path), "--format", "html", "-o", str(page)],
-        capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
+    done = run_station("report", str(path), "--format", "html", "-o", str(page))  # fmt: skip
     assert done.returncode == 0, done.stderr
     html = page.read_text()
     assert "Deviation against the target, approached up and down" in html

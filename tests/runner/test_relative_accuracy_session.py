@@ -10,7 +10,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from helpers import STATION
+from helpers import STATION, run_station
 
 from station.analysis.document import to_json
 from station.instruments.protocols import get_protocol
@@ -42,9 +42,7 @@ def model(seed: int) -> TwoFixtureModel:
 
 
 def analyze_json(path: Path) -> dict:
-    done = subprocess.run(
-        [*STATION, "analyze", str(path), "--json"], capture_output=True, text=True, timeout=60
-    )
+    done = run_station("analyze", str(path), "--json")
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
 
@@ -52,7 +50,7 @@ def analyze_json(path: Path) -> dict:
 def assert_recovers(path: Path, seed: int) -> None:
     """The file's analysis gives the configured scale error per axis, the pendant of every
     placement, and each placement's error near the model's."""
-    done = subprocess.run([*STATION, "verify", str(path)], capture_output=True, text=True)
+    done = run_station("verify", str(path))
     assert done.returncode == 0, done.stdout + done.stderr
     accuracy = analyze_json(path)["accuracy"]
     truth = model(seed)
