@@ -322,8 +322,10 @@ def _trends(
             if found is not None:
                 day = found[0]
                 crossing = (_date(first, found[0]), _date(first, found[1]), _date(first, found[2]))
-        if cpk_fit is None or threshold is None:
-            cpk_sentence = f"{channel}: too few sessions with a Cpk for a trend of Cpk."
+        if threshold is None or not judged:
+            cpk_sentence = f"{channel}: no Cpk to trend (no session has limits for it)."
+        elif cpk_fit is None:
+            cpk_sentence = f"{channel}: too few sessions with a Cpk ({len(judged)}) for its trend."
         else:
             cpk_sentence = _cpk_sentence(channel, cpk_fit, threshold, crossing, cpk_days[-1], day)
         trends.append(
