@@ -16,11 +16,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="compare two sessions (before/after an adjustment): shifts, spreads, RP, 3-D",
         description=(
             "Compare session A (before) with session B (after), channel by channel: the mean "
-            "shift B - A with Welch's t test and its confidence interval, the spread ratio "
+            "shift B - A with its t test and confidence interval (Welch's; where each session "
+            "took its own zero, each zero's rest-to-rest uncertainty, from the session's own "
+            "spread and the zero's readings, is counted in, and the sentence says when the "
+            "zeros make up most of the shift), the spread ratio "
             "sigma_B/sigma_A with its F-test interval and the Brown-Forsythe (Levene, median) "
             "test, a plain sentence per channel; the 3-D shift of the mean of x, y, z with "
             "Hotelling's T2; the change of RP. Holm's procedure holds the chance of calling any "
-            "unchanged channel changed at 1 - confidence (5%). Sessions of different procedures "
+            "unchanged channel changed at 1 - confidence (5%); a sentence says when Holm's "
+            "correction made the call. Sessions of different procedures "
             "or units are refused."
         ),
     )

@@ -16,10 +16,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "List every session of ROBOT (its exact name) in the sessions folder, oldest first: "
             "procedure, verdict, RP, per-channel mean offset, sigma and Cpk, and the anchor (the "
             "last line hash). Text charts of RP and Cpk over time follow, then the wear trend: "
-            "per channel the slope of the session means against the date with its 95% "
-            "confidence interval and, where it is significant, the date at which the trend "
-            "line would reach a limit. Sessions of the latest session's procedure and unit are "
-            "trended. "
+            "per channel the slopes of the sessions' Cpk and means against the date with their "
+            "95% confidence intervals and, only where Cpk's slope is significant, the date at "
+            "which its trend line reaches the threshold, with a 95% range of dates. Sessions of "
+            "the latest session's procedure and unit are trended. "
             "The robot's baseline session is marked."
         ),
     )

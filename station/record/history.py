@@ -1,12 +1,20 @@
 """A robot's history: every session of it in time order, the figures that follow it over the
 months (RP, per-axis mean offset, σ, Cpk, verdict, anchor), and the wear trend.
 
-The wear trend is, per channel, the least-squares line of the session means against the date
-(the report's periodic testing, §1.3: a robot that wears drifts off its nominal). Its slope is
-given with a confidence interval (Student's t on n − 2 degrees of freedom); where the slope is
-significant (the interval excludes 0) and heads for a limit, the date at which the line would
-reach that limit is given too. Only sessions of the latest session's procedure and unit are
-trended together.
+The wear trend is, per channel, two least-squares lines against the date, each slope with its
+confidence interval (Student's t on n − 2 degrees of freedom) and p (the report's periodic
+testing, §1.3: a robot that wears drifts off its nominal and scatters more):
+
+* **Cpk** of each session against the latest session's threshold. Only where its slope is
+  significant (the interval excludes 0) is a date given: the day the line reaches the threshold,
+  with the range of days at which the true line may reach it (Fieller's inverse-regression
+  interval, :func:`threshold_crossing`, finite exactly when the slope is significant). Cpk is
+  what a verdict turns on, so its date is the one that matters; otherwise the sentence says
+  there is no significant trend and gives no date.
+* the **mean**, described (per 30 days) but never dated: a mean that reaches a limit has half
+  its returns out already.
+
+Only sessions of the latest session's procedure and unit are trended together.
 """
 
 from __future__ import annotations
@@ -49,6 +57,8 @@ class ChannelFigures:
     capable: bool | None
     usl: float | None
     lsl: float | None
+    threshold: float | None = None
+    """The Cpk the session's verdict holds the channel to."""
 
 
 @dataclass(frozen=True)
@@ -73,9 +83,14 @@ class HistoryEntry:
 
 @dataclass(frozen=True)
 class Trend:
-    """The wear trend of one channel's session means: slope per day with its confidence
-    interval and p-value; ``crossing`` is the date the line reaches ``limit`` (None when the
-    slope is not significant or heads for no limit)."""
+    """The wear trend of one channel over the sessions.
+
+    The mean: its slope per day with the confidence interval and p-value (described, never
+    dated: by the time the mean reaches a limit half the returns are already out). Cpk: its
+    slope per day with interval and p; where that slope is significant, ``crossing`` is the date
+    the line reaches ``threshold`` and ``crossing_low``/``crossing_high`` the range of dates
+    at which the true line may reach it (:func:`threshold_crossing`); None otherwise (no
+    significant trend, no Cpk, or a date beyond the calendar)."""
 
     channel: str
     procedure: str
@@ -85,9 +100,16 @@ class Trend:
     ci_high: float
     p_value: float
     significant: bool
-    limit: float | None = None
-    limit_name: str | None = None
+    cpk_sessions: int = 0
+    cpk_slope_per_day: float | None = None
+    cpk_ci_low: float | None = None
+    cpk_ci_high: float | None = None
+    cpk_p_value: float | None = None
+    cpk_significant: bool = False
+    threshold: float | None = None
     crossing: str | None = None
+    crossing_low: str | None = None
+    crossing_high: str | None = None
     sentence: str = ""
 
 
@@ -131,6 +153,7 @@ def _entry(path: Path, baseline_session: str | None) -> HistoryEntry:
                 capable=cap.capable,
                 usl=None if channel.limits is None else channel.limits.usl,
                 lsl=None if channel.limits is None else channel.limits.lsl,
+                threshold=cap.threshold,
             )
         if analysis.spatial is not None:
             rp = analysis.spatial.rp
@@ -180,6 +203,79 @@ def wear_trend(
     )
 
 
+def threshold_crossing(
+    days: Sequence[float],
+    values: Sequence[float],
+    threshold: float,
+    *,
+    confidence: float = 0.95,
+) -> tuple[float, float, float] | None:
+    """When the least-squares line of ``values`` against ``days`` reaches ``threshold``:
+    (day, low, high), the range being Fieller's interval (inverse regression): the days at
+    which ``threshold`` lies inside the line's confidence band,
+    (a + b·x − T)² ≤ t²·s²·(1/n + (x − x̄)²/Sxx), t on n − 2 degrees of freedom. The range is
+    finite exactly when the slope is significant at ``confidence`` (its interval excludes 0);
+    None otherwise, with fewer than three points or all on one day."""
+    from scipy import stats  # on first use: see README, Development
+
+    x = np.asarray(days, dtype=float)
+    y = np.asarray(values, dtype=float)
+    if x.size < 3 or np.ptp(x) == 0:
+        return None
+    n = x.size
+    mean_x, mean_y = float(x.mean()), float(y.mean())
+    sxx = float(((x - mean_x) ** 2).sum())
+    slope = float(((x - mean_x) * (y - mean_y)).sum() / sxx)
+    residual = y - (mean_y + slope * (x - mean_x))
+    s2 = float((residual**2).sum() / (n - 2))
+    t2 = float(stats.t.ppf(0.5 + confidence / 2, n - 2)) ** 2
+    a = slope * slope - t2 * s2 / sxx
+    if slope == 0 or a <= 0:
+        return None  # the band holds a flat line: any day, or none, could be the one
+    gap = threshold - mean_y
+    root = math.sqrt(max(0.0, slope * slope * gap * gap - a * (gap * gap - t2 * s2 / n)))
+    low, high = sorted(((slope * gap - root) / a, (slope * gap + root) / a))
+    return mean_x + gap / slope, mean_x + low, mean_x + high
+
+
+def _date(first: datetime, day: float) -> str | None:
+    """The calendar date ``day`` days after ``first``; None beyond the calendar."""
+    try:
+        return (first + timedelta(days=day)).strftime("%Y-%m-%d")
+    except (OverflowError, ValueError):
+        return None
+
+
+def _cpk_sentence(
+    channel: str,
+    fit: tuple[float, float, float, float, float],
+    threshold: float,
+    crossing: tuple[str | None, str | None, str | None] | None,
+    latest_day: float,
+    day: float | None,
+) -> str:
+    slope, low, high, p_value, _ = fit
+    interval = (
+        f"(95% CI {format_index(low * 30)} to {format_index(high * 30)}, {p_phrase(p_value)})"
+    )
+    if crossing is None or day is None:
+        return f"{channel}: Cpk shows no significant trend {interval}: no date is given."
+    word = "falls" if slope < 0 else "rises"
+    per_30 = f"Cpk {word} {format_index(abs(slope) * 30)} per 30 days {interval}"
+    date, earliest, latest = (d or "beyond 9999" for d in crossing)
+    span = f"(95% range {earliest} to {latest})"
+    level = format_index(threshold)
+    if day > latest_day:
+        return (
+            f"{channel}: {per_30}; at this rate it reaches the threshold {level} on {date} {span}."
+        )
+    side = "below" if slope < 0 else "above"
+    return (
+        f"{channel}: {per_30}; the trend line crossed the threshold {level} on {date} {span} "
+        f"and is {side} it now."
+    )
+
+
 def _trends(
     entries: Sequence[HistoryEntry], unit: str, resolution: float | None
 ) -> tuple[Trend, ...]:
@@ -191,40 +287,47 @@ def _trends(
     same = [e for e in analysed if e.procedure == procedure and e.unit == unit_of_latest]
     first = parse_time(same[0].created)
     assert first is not None
+
+    def day_of(entry: HistoryEntry) -> float:
+        return (parse_time(entry.created) - first).total_seconds() / SECONDS_PER_DAY  # type: ignore[operator]
+
     trends = []
     for channel in same[-1].channels:
         rows = [e for e in same if channel in e.channels]
-        days = [(parse_time(e.created) - first).total_seconds() / SECONDS_PER_DAY for e in rows]  # type: ignore[operator]
+        days = [day_of(e) for e in rows]
         fit = wear_trend(days, [e.channels[channel].mean for e in rows])
         if fit is None:
             continue
-        slope, low, high, p_value, intercept = fit
+        slope, low, high, p_value, _ = fit
         significant = low > 0 or high < 0
-        latest = rows[-1].channels[channel]
-        limit, limit_name = (latest.usl, "USL") if slope > 0 else (latest.lsl, "LSL")
-        crossing = None
-        per_30 = f"{format_figure(slope * 30, resolution, unit=unit)} per 30 days"
         interval = (
             f"(95% CI {format_figure(low * 30, resolution)} to "
             f"{format_figure(high * 30, resolution)}, {p_phrase(p_value)})"
         )
-        if significant and limit is not None and slope != 0:
-            day = (limit - intercept) / slope
-            if day > days[-1]:
-                crossing = (first + timedelta(days=day)).strftime("%Y-%m-%d")
-                sentence = (
-                    f"{channel}: the mean moves {per_30} {interval}; at this rate it reaches "
-                    f"the {limit_name} {format_figure(limit, resolution)} on {crossing}."
-                )
-            else:
-                sentence = (
-                    f"{channel}: the mean moves {per_30} {interval} and the trend line is "
-                    f"already past the {limit_name} {format_figure(limit, resolution)}."
-                )
-        elif significant:
-            sentence = f"{channel}: the mean moves {per_30} {interval}; no limit to reach."
+        if significant:
+            per_30 = f"{format_figure(slope * 30, resolution, unit=unit)} per 30 days"
+            mean_sentence = f"The mean moves {per_30} {interval}."
         else:
-            sentence = f"{channel}: no significant trend {interval}."
+            mean_sentence = f"The mean shows no significant trend {interval}."
+        # Cpk against the threshold of the latest session: the date a verdict would change.
+        threshold = rows[-1].channels[channel].threshold
+        judged = [e for e in rows if e.channels[channel].cpk is not None]
+        cpk_days = [day_of(e) for e in judged]
+        cpks = [float(e.channels[channel].cpk) for e in judged]  # type: ignore[arg-type]
+        cpk_fit = wear_trend(cpk_days, cpks) if threshold is not None else None
+        crossing = None
+        day = None
+        if cpk_fit is not None and threshold is not None:
+            found = threshold_crossing(cpk_days, cpks, threshold)
+            if found is not None:
+                day = found[0]
+                crossing = (_date(first, found[0]), _date(first, found[1]), _date(first, found[2]))
+        if threshold is None or not judged:
+            cpk_sentence = f"{channel}: no Cpk to trend (no session has limits for it)."
+        elif cpk_fit is None:
+            cpk_sentence = f"{channel}: too few sessions with a Cpk ({len(judged)}) for its trend."
+        else:
+            cpk_sentence = _cpk_sentence(channel, cpk_fit, threshold, crossing, cpk_days[-1], day)
         trends.append(
             Trend(
                 channel=channel,
@@ -235,10 +338,17 @@ def _trends(
                 ci_high=high,
                 p_value=p_value,
                 significant=significant,
-                limit=limit if crossing else None,
-                limit_name=limit_name if crossing else None,
-                crossing=crossing,
-                sentence=sentence,
+                cpk_sessions=len(judged),
+                cpk_slope_per_day=None if cpk_fit is None else cpk_fit[0],
+                cpk_ci_low=None if cpk_fit is None else cpk_fit[1],
+                cpk_ci_high=None if cpk_fit is None else cpk_fit[2],
+                cpk_p_value=None if cpk_fit is None else cpk_fit[3],
+                cpk_significant=crossing is not None,
+                threshold=threshold,
+                crossing=None if crossing is None else crossing[0],
+                crossing_low=None if crossing is None else crossing[1],
+                crossing_high=None if crossing is None else crossing[2],
+                sentence=f"{cpk_sentence} {mean_sentence}",
             )
         )
     return tuple(trends)
@@ -358,9 +468,15 @@ def history_json(history: RobotHistory) -> dict[str, Any]:
                 "ci_high": t.ci_high,
                 "p_value": t.p_value,
                 "significant": t.significant,
-                "limit": t.limit,
-                "limit_name": t.limit_name,
+                "cpk_sessions": t.cpk_sessions,
+                "cpk_slope_per_day": t.cpk_slope_per_day,
+                "cpk_ci_low": t.cpk_ci_low,
+                "cpk_ci_high": t.cpk_ci_high,
+                "cpk_p_value": t.cpk_p_value,
+                "cpk_significant": t.cpk_significant,
+                "threshold": t.threshold,
                 "crossing": t.crossing,
+                "crossing_range": [t.crossing_low, t.crossing_high],
                 "sentence": t.sentence,
             }
             for t in history.trends

@@ -8,6 +8,7 @@ configuration (the session package never reaches up into the engine for it).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -16,6 +17,7 @@ from station.analysis.capability import SpecLimits
 from station.analysis.phases import DEFAULT_FREEZE_AFTER, baseline_from_json
 from station.analysis.summary import AnalysisConfig
 from station.analysis.verdict import DEFAULT_MIN_N
+from station.analysis.zeros import ZeroDraw
 
 
 def header_limits(header: Mapping[str, Any]) -> dict[str, SpecLimits]:
@@ -45,6 +47,53 @@ def zero_uncertainties(zeroes: Iterable[Mapping[str, Any]]) -> dict[str, float]:
             else:
                 found.pop(str(channel), None)
     return found
+
+
+def _zero_draw(spec: object) -> ZeroDraw:
+    """One channel's entry of a ``zero`` event as a :class:`ZeroDraw` (weight 0 until readings
+    are counted under it). A gauge's own zero command takes its reading of that moment: m = 1."""
+    if not isinstance(spec, Mapping) or spec.get("method") == "device":
+        return ZeroDraw(readings=1, within_sd=None, weight=0)
+    values = [
+        float(v)
+        for v in spec.get("values") or ()
+        if isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+    ]
+    count = spec.get("n")
+    m = count if isinstance(count, int) and not isinstance(count, bool) and count >= 1 else None
+    if m is None:
+        m = len(values) or 1
+    within = None
+    if len(values) >= 2:
+        mean = sum(values) / len(values)
+        within = math.sqrt(sum((v - mean) ** 2 for v in values) / (len(values) - 1))
+    return ZeroDraw(readings=m, within_sd=within, weight=0)
+
+
+def zero_draws(events: Iterable[Mapping[str, Any]]) -> dict[str, tuple[ZeroDraw, ...]]:
+    """Per channel, the zeros a session's readings were taken under, in order, each weighted by
+    the ``reading`` events (or streamed ``samples`` events) of the channel that followed it
+    before the channel's next zero; a zero no reading followed is left out. A channel the
+    session never zeroed has no entry: its readings are the gauge's own values."""
+    found: dict[str, list[ZeroDraw]] = {}
+    for event in events:
+        kind = event.get("type")
+        if kind == "zero":
+            for channel, spec in dict(event.get("channels") or {}).items():
+                found.setdefault(str(channel), []).append(_zero_draw(spec))
+        elif kind in ("reading", "samples"):
+            named = event.get("channels")
+            channels = named if isinstance(named, dict | list | tuple) else ()
+            for channel in channels:
+                draws = found.get(str(channel))
+                if draws:
+                    last = draws[-1]
+                    draws[-1] = ZeroDraw(last.readings, last.within_sd, last.weight + 1)
+    return {
+        channel: used
+        for channel, draws in found.items()
+        if (used := tuple(d for d in draws if d.weight > 0))
+    }
 
 
 def analysis_config(

@@ -9,6 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from station.instruments.simulator import FixtureModel
+from station.instruments.zeroing import zero_from_readings
 from station.procedures import discover_procedures
 from station.run import PortSetup, SessionSetup
 from station.session.journal import SessionWriter
@@ -95,6 +97,67 @@ def write_repeatability(
                 cycles=[5],
                 text="cycle 5 beyond the control limits",
             )
+        writer.append("finish", by="operator", complete=True, accepted=cycles, rejected=[])
+    return writer.path
+
+
+def simulated_session(
+    model: FixtureModel, seed: int, *, cycles: int = 30, zero_readings: int = 5
+) -> tuple[list[dict], list[dict]]:
+    """A repeatability session of the simulator's ``model`` as the runner takes it: the zero
+    step reads every gauge ``zero_readings`` times at the robot's first rest and records the
+    mean (:func:`~station.instruments.zeroing.zero_from_readings`, the record and uncertainty
+    the zero step writes); each cycle then reads the gauges once at the next rest, less the
+    zero. Returns the ``zero`` event's fields and the ``reading`` events' fields."""
+    channels = model.channels
+    resolution = {c: model.gauge(c).resolution for c in channels}
+    zeros = zero_from_readings(
+        {c: [model.reading(c, 0, k, seed) for k in range(zero_readings)] for c in channels},
+        resolution,
+        min_readings=zero_readings,
+    )
+    offsets = {z.channel: z.offset for z in zeros}
+    zero = {
+        "step": "zero",
+        "channels": {z.channel: {**z.record(), "uncertainty": z.uncertainty} for z in zeros},
+        "by": "operator",
+    }
+    readings = []
+    for cycle in range(1, cycles + 1):
+        shown = {c: model.reading(c, cycle, zero_readings + cycle - 1, seed) for c in channels}
+        readings.append(
+            {
+                "cycle": cycle,
+                "step": "cycles",
+                "channels": {
+                    c: {
+                        "value": round(value - offsets[c], 6),
+                        "raw_value": value,
+                        "zero": offsets[c],
+                        "unit": model.gauge(c).unit,
+                        "raw": f"01A{value:+.4f}",
+                    }
+                    for c, value in shown.items()
+                },
+                "by": "operator",
+            }
+        )
+    return [zero], readings
+
+
+def write_simulated(
+    folder: Path, model: FixtureModel, seed: int, *, robot: str = "KSC-7", cycles: int = 30
+) -> Path:
+    """A finished repeatability session file of :func:`simulated_session`, written through the
+    real SessionWriter."""
+    zeros, readings = simulated_session(model, seed, cycles=cycles)
+    header = header_fields("repeatability", robot=robot)
+    with SessionWriter.create(folder, header, now=WHEN) as writer:
+        writer.append("step", step="fixture", action="confirmed", by="operator")
+        for zero in zeros:
+            writer.append("zero", **zero)
+        for reading in readings:
+            writer.append("reading", **reading)
         writer.append("finish", by="operator", complete=True, accepted=cycles, rejected=[])
     return writer.path
 

@@ -7,18 +7,19 @@ import os
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from station.cli import main
 from station.errors import StationError
 from station.record.baseline import baseline_for, baseline_path, clear_baseline, store_baseline
-from station.record.history import robot_history, text_chart
+from station.record.history import robot_history, text_chart, threshold_crossing
 
 from .conftest import write_repeatability
 
 START = datetime(2026, 1, 5, 9, 0, tzinfo=UTC)
 STEP_DAYS = 30
-BIAS_STEP = 0.0001  # x drifts 0.0001 in per 30 days: the USL +0.001 is reached on day 300
+BIAS_STEP = 0.0001  # x drifts 0.0001 in per 30 days: its Cpk reaches 1 on day 120
 
 
 def five_sessions(folder, robot="KSC-7"):
@@ -41,6 +42,9 @@ def five_sessions(folder, robot="KSC-7"):
 
 
 def test_history_shows_the_wear_trend_and_its_crossing_date(sessions, capsys):
+    # x's Cpk is (0.001 − bias)/(3 × 0.0002): 1.67 on day 0, the threshold 1 on day 120, the last
+    # session's. The date is Cpk's reaching the threshold with its range (it once was the mean's
+    # reaching the USL, on day 300, when half the returns are out: the bug of issue 20).
     paths = five_sessions(sessions)
     history = robot_history(sessions, "KSC-7")
     assert [e.path for e in history.entries] == paths
@@ -48,26 +52,88 @@ def test_history_shows_the_wear_trend_and_its_crossing_date(sessions, capsys):
     x = trends["x"]
     assert x.significant and x.ci_low > 0
     assert x.slope_per_day * STEP_DAYS == pytest.approx(BIAS_STEP, rel=0.35)
-    expected = START + timedelta(days=300)
-    crossing = datetime.fromisoformat(x.crossing).replace(tzinfo=UTC)
-    assert abs((crossing - expected).days) <= 60
-    assert x.limit == pytest.approx(0.001) and x.limit_name == "USL"
+    assert x.cpk_significant and x.cpk_ci_high < 0 and x.threshold == 1.0
+    expected = (START + timedelta(days=120)).strftime("%Y-%m-%d")
+    assert x.crossing_low <= expected <= x.crossing_high
+    assert x.crossing_low <= x.crossing <= x.crossing_high
     for axis in ("y", "z"):
-        assert not trends[axis].significant and trends[axis].crossing is None
+        assert not trends[axis].cpk_significant and trends[axis].crossing is None
 
     assert main(["history", "KSC-7", "--sessions", str(sessions)]) == 0
     out = capsys.readouterr().out
     assert "History of robot KSC-7 (5 sessions)" in out
-    assert f"reaches the USL +0.00100 on {x.crossing}" in out
+    assert (
+        f"the trend line crossed the threshold 1.00 on {x.crossing} "
+        f"(95% range {x.crossing_low} to {x.crossing_high}) and is below it now" in out
+    )
     assert "RP over the sessions" in out and "Cpk of x over the sessions" in out
-    assert "y: no significant trend" in out
+    assert "y: Cpk shows no significant trend" in out and "USL" not in out
 
     assert main(["history", "KSC-7", "--sessions", str(sessions), "--json"]) == 0
     document = json.loads(capsys.readouterr().out)
     assert [s["file"] for s in document["sessions"]] == [p.name for p in paths]
     assert document["trends"][0]["crossing"] == x.crossing
+    assert document["trends"][0]["crossing_range"] == [x.crossing_low, x.crossing_high]
     offsets = [s["channels"]["x"]["offset"] for s in document["sessions"]]
     assert offsets == sorted(offsets) or offsets[-1] > offsets[0] + 0.0003
+
+
+def test_history_dates_when_cpk_will_reach_the_threshold_with_a_range(sessions, capsys):
+    """x's bias grows 0.00003 in a month: its Cpk, (0.001 − bias)/0.0006, reaches 1 on day 400,
+    after the last session (day 270). The date comes with a range that holds the true one;
+    y and z, unchanged, have no significant trend and no date."""
+    for k in range(10):
+        write_repeatability(
+            sessions,
+            seed=200 + k,
+            bias={"x": 0.00003 * k},
+            cycles=60,
+            created=START + timedelta(days=STEP_DAYS * k),
+            reject=None,
+            alarm=False,
+        )
+    trends = {t.channel: t for t in robot_history(sessions, "KSC-7").trends}
+    x = trends["x"]
+    true = (START + timedelta(days=400)).strftime("%Y-%m-%d")
+    last = (START + timedelta(days=270)).strftime("%Y-%m-%d")
+    assert x.cpk_significant and last < x.crossing
+    assert x.crossing_low <= true <= x.crossing_high
+    assert x.sentence.startswith(
+        f"x: Cpk falls {abs(x.cpk_slope_per_day) * 30:.2f} per 30 days (95% CI "
+    )
+    assert (
+        f"at this rate it reaches the threshold 1.00 on {x.crossing} "
+        f"(95% range {x.crossing_low} to {x.crossing_high})." in x.sentence
+    )
+    for axis in ("y", "z"):
+        flat = trends[axis]
+        assert not flat.cpk_significant and flat.crossing is None
+        assert flat.crossing_low is None and flat.crossing_high is None
+        assert flat.sentence.startswith(f"{axis}: Cpk shows no significant trend (95% CI ")
+        assert "no date is given" in flat.sentence
+
+
+def test_threshold_crossing_is_where_the_confidence_band_holds_the_threshold():
+    from scipy import stats
+
+    days = np.array([0.0, 30, 60, 90, 120, 150])
+    cpk = np.array([1.9, 1.75, 1.72, 1.5, 1.48, 1.3])
+    day, low, high = threshold_crossing(days, cpk, 1.0)
+    fit = stats.linregress(days, cpk)
+    assert fit.intercept + fit.slope * day == pytest.approx(1.0)
+    # Brute force: the days whose band (t on 4 dof) contains 1.0.
+    grid = np.linspace(-200, 1000, 120001)
+    n, mean = days.size, days.mean()
+    s2 = ((cpk - fit.intercept - fit.slope * days) ** 2).sum() / (n - 2)
+    half = stats.t.ppf(0.975, n - 2) * np.sqrt(
+        s2 * (1 / n + (grid - mean) ** 2 / ((days - mean) ** 2).sum())
+    )
+    inside = grid[np.abs(fit.intercept + fit.slope * grid - 1.0) <= half]
+    assert low == pytest.approx(inside.min(), abs=0.02)
+    assert high == pytest.approx(inside.max(), abs=0.02)
+    # A slope the interval does not tell from 0 gives no date at all.
+    assert threshold_crossing(days, [1.5, 1.9, 1.4, 1.8, 1.45, 1.7], 1.0) is None
+    assert threshold_crossing(days[:2], cpk[:2], 1.0) is None
 
 
 def test_history_of_an_unknown_robot_says_so(sessions, capsys):
