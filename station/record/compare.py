@@ -120,7 +120,7 @@ def compare_axis(
     ``spread_changed`` are the decisions (Holm's, from :func:`compare_sessions`); None decides
     on this axis alone at 1 − ``confidence``. ``resolution``: the gauge step the sentence
     writes the shifts at (:func:`~station.text.format_figure`)."""
-    from scipy import stats  # on first use: see README, Development
+    from scipy import stats  # on first use: see station/README.md
 
     x = np.asarray(a, dtype=float)
     y = np.asarray(b, dtype=float)
@@ -208,7 +208,7 @@ def compare_axis(
 def hotelling_t2(a: Any, b: Any) -> Hotelling | None:
     """The two-sample Hotelling T² of the means of ``a`` and ``b`` (rows: readings, columns:
     x, y, z); None when there are too few readings or the pooled covariance is singular."""
-    from scipy import stats  # on first use: see README, Development
+    from scipy import stats  # on first use: see station/README.md
 
     x = np.asarray(a, dtype=float)
     y = np.asarray(b, dtype=float)
