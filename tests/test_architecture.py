@@ -40,7 +40,7 @@ def _loaded_after(code: str) -> set[str]:
 
 
 def test_station_help_loads_no_numpy():
-    """README, Development: a command imports what it needs inside its ``run``."""
+    """station/README.md, Deferred imports: a command imports what it needs inside its ``run``."""
     loaded = _loaded_after(
         "from station.cli import main\ntry:\n    main(['--help'])\nexcept SystemExit:\n    pass"
     )
@@ -48,9 +48,9 @@ def test_station_help_loads_no_numpy():
 
 
 def test_importing_the_engine_and_the_record_screens_loads_no_scipy():
-    """README, Development: the analysis and the record import scipy where they use it, so a
-    screen that imports the engine or the record on the UI thread does not wait for scipy (the
-    TUI loads it on a worker thread)."""
+    """station/README.md, Deferred imports: the analysis and the record import scipy where they
+    use it, so a screen that imports the engine or the record on the UI thread does not wait for
+    scipy (the TUI loads it on a worker thread)."""
     loaded = _loaded_after(
         "import station.run, station.methods\n"
         "import station.record.history, station.record.compare, station.record.render"

@@ -150,7 +150,7 @@ def _check_confidence(confidence: float) -> float:
 
 def cp_interval(cp: float, n: int, confidence: float = 0.95) -> tuple[float, float]:
     """Two-sided chi-square confidence interval on Cp from ``n`` readings (qcc, SAS)."""
-    from scipy.special import chdtri  # on first use: see README, Development
+    from scipy.special import chdtri  # on first use: see station/README.md
 
     alpha = 1 - _check_confidence(confidence)
     if n < 2:

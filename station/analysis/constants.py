@@ -37,7 +37,7 @@ def _check_size(n: int, smallest: int) -> int:
 @cache
 def _range_moments(n: int) -> tuple[float, float]:
     """(E[R], SD[R]) of the range of n iid N(0, 1) values, by 1-D and 2-D quadrature."""
-    from scipy.special import ndtr  # on first use: see README, Development
+    from scipy.special import ndtr  # on first use: see station/README.md
 
     nodes, weights = np.polynomial.legendre.leggauss(_NODES)
     x = _HALF_WIDTH * nodes

@@ -201,7 +201,7 @@ def gauge_check(
     Raises StationError for fewer than 2 readings, a value that is not finite, or a tolerance or
     resolution that is not positive.
     """
-    from scipy import stats  # on first use: see README, Development
+    from scipy import stats  # on first use: see station/README.md
 
     readings = np.asarray(values, dtype=float).ravel()
     if readings.size < 2:

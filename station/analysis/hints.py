@@ -56,7 +56,7 @@ def t_quantile(p: float, degrees: int) -> float:
     Cornish-Fisher series in 1/degrees (Abramowitz & Stegun 26.7.5, four terms), exact to
     double precision there and without loading scipy for a large file."""
     if degrees < _T_SERIES_FROM:
-        from scipy.special import stdtrit  # on first use: see README, Development
+        from scipy.special import stdtrit  # on first use: see station/README.md
 
         return float(stdtrit(degrees, p))
     z = NormalDist().inv_cdf(p)

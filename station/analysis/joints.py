@@ -217,7 +217,7 @@ def analyze_joints(
     from the cube (the base) spreads it more for the same angular repeatability, and without
     the lever arms the comparison is of what the fixture sees, which is what the verdict judges
     but not a fault of the joint."""
-    from scipy import stats  # on first use: see README, Development
+    from scipy import stats  # on first use: see station/README.md
 
     missing = [axis for axis in AXES if axis not in readings]
     if missing:

@@ -211,7 +211,7 @@ def compare_axis(
     ``zeros_b``: the zeros each session's readings were taken under
     (:func:`station.session.header.zero_draws`); none in either is one shared reference, and
     the test is Welch's."""
-    from scipy import stats  # on first use: see README, Development
+    from scipy import stats  # on first use: see station/README.md
 
     x = np.asarray(a, dtype=float)
     y = np.asarray(b, dtype=float)
@@ -330,7 +330,7 @@ def hotelling_t2(
     in 3-D correlates across the axes as the rests do), T² = d̄ᵀ (V_A + V_B)⁻¹ d̄, and
     F = T²·(ν − p + 1)/(p·ν) on (p, ν − p + 1) degrees of freedom with Nel and Van der Merwe's
     ν = (tr V² + (tr V)²) / Σ_i (tr V_i² + (tr V_i)²)/(n_i − 1)."""
-    from scipy import stats  # on first use: see README, Development
+    from scipy import stats  # on first use: see station/README.md
 
     x = np.asarray(a, dtype=float)
     y = np.asarray(b, dtype=float)

@@ -184,7 +184,7 @@ def wear_trend(
 ) -> tuple[float, float, float, float, float] | None:
     """The least-squares slope of ``means`` against ``days``: (slope, ci_low, ci_high,
     p_value, intercept); None with fewer than three sessions or all on one day."""
-    from scipy import stats  # on first use: see README, Development
+    from scipy import stats  # on first use: see station/README.md
 
     x = np.asarray(days, dtype=float)
     y = np.asarray(means, dtype=float)

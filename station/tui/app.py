@@ -44,7 +44,7 @@ from station.tui.screens.home import HomeScreen
 from station.tui.theme import HIGH_CONTRAST_THEME, apply_palette, wanted_theme
 from station.tui.widgets.too_small import TooSmallNotice, too_small
 
-# Deliberately imported where first used, for start-up time (README, Development): the other
+# Deliberately imported where first used, for start-up time (station/README.md): the other
 # screens when first shown, the procedure catalogue when first asked for (about 60 ms), and the
 # engine (station.run), which loads numpy, when a session starts; numpy and scipy themselves load
 # on a worker thread (warm_up_analysis). So the home screen appears at once.

@@ -176,7 +176,9 @@ def test_a_missing_file_is_one_line(tmp_path):
 
 
 def test_the_readme_example_runs(tmp_path):
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
+    """The budget example of station/analysis/README.md (it was in the top-level README)."""
+    root = Path(__file__).resolve().parents[2]
+    readme = (root / "station" / "analysis" / "README.md").read_text(encoding="utf-8")
     section = readme.split("station budget FILE.toml", 1)[1]
     example = section.split("```toml\n", 1)[1].split("```", 1)[0]
     document = json.loads(run_station("budget", write(tmp_path, example), "--json").stdout)

@@ -83,6 +83,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "summary with the session file and its last hash. SIGHUP/SIGTERM/SIGINT write an "
             "'interrupted' event and exit 129/143/130; continue with --resume FILE."
         ),
+        epilog=(
+            "exit codes: 0 finished; 2 an error, one line on stderr (nothing is written when "
+            "the set-up or the gauges are refused); 70 station capture itself failed (the "
+            "session is left interrupted and resumable); 129/130/143 after SIGHUP/SIGINT/SIGTERM"
+        ),
     )
     parser.add_argument("--procedure", metavar="ID", help="procedure id (see station procedures)")
     parser.add_argument("--port", metavar="URL", help="serial port, rfc2217:// or socket:// URL")

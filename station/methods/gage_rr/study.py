@@ -633,7 +633,7 @@ def _ratio(numerator: float, denominator: float) -> float:
 
 
 def _f_row(source: str, df: int, ss: float, against: float, df_against: int) -> AnovaRow:
-    from scipy import stats  # on first use: see README, Development
+    from scipy import stats  # on first use: see station/README.md
 
     ms = ss / df
     f = _ratio(ms, against)

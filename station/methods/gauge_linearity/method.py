@@ -104,7 +104,7 @@ def _readings(inputs: MethodInputs) -> tuple[np.ndarray, np.ndarray]:
 def bias_chart(study: LinearityStudy, references: Any, values: Any, kit: ChartKit) -> Any:
     """Every reading's bias against its master's size, each master's mean bias, the fitted
     line with its 95 % confidence band, bias = 0, and the bias allowed (with a tolerance)."""
-    from scipy import stats  # on first use: see README, Development
+    from scipy import stats  # on first use: see station/README.md
 
     x = np.asarray(references, dtype=float)
     y = np.asarray(values, dtype=float) - x

@@ -82,7 +82,7 @@ class MasterBias:
     @property
     def half_width(self) -> float | None:
         """The 95 % confidence half-width of its bias (None with one reading)."""
-        from scipy import stats  # on first use: see README, Development
+        from scipy import stats  # on first use: see station/README.md
 
         if self.n < 2:
             return None
@@ -304,7 +304,7 @@ def _p(value: float) -> str:
 
 
 def _two_sided_p(t: float, df: int) -> float:
-    from scipy import stats  # on first use: see README, Development
+    from scipy import stats  # on first use: see station/README.md
 
     return float(2.0 * stats.t.sf(abs(t), df))
 
@@ -326,7 +326,7 @@ def linearity_study(
     Raises StationError for fewer than 2 masters, a master read once, a value that is not
     finite, or a PV, tolerance or resolution that is not positive.
     """
-    from scipy import stats  # on first use: see README, Development
+    from scipy import stats  # on first use: see station/README.md
 
     x = np.asarray(references, dtype=float).ravel()
     z = np.asarray(values, dtype=float).ravel()
