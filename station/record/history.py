@@ -216,7 +216,7 @@ def threshold_crossing(
     (a + b·x − T)² ≤ t²·s²·(1/n + (x − x̄)²/Sxx), t on n − 2 degrees of freedom. The range is
     finite exactly when the slope is significant at ``confidence`` (its interval excludes 0);
     None otherwise, with fewer than three points or all on one day."""
-    from scipy import stats  # on first use: see README, Development
+    from scipy import stats  # on first use: see station/README.md
 
     x = np.asarray(days, dtype=float)
     y = np.asarray(values, dtype=float)
