@@ -9,6 +9,10 @@ limits use the within-subgroup sigma, with constants computed in :mod:`constants
 * X-bar-R: sigma = R-bar / d2(n); limits X-double-bar +- A2 * R-bar; R chart D3/D4 * R-bar.
 * X-bar-S: sigma = S-bar / c4(n); limits X-double-bar +- A3 * S-bar; S chart B3/B4 * S-bar.
 
+The location chart's limits are never narrower than the gauge can tell apart: with a gauge
+``resolution`` their half-width is at least 1.5 steps
+(:func:`~station.analysis.discrimination.limit_half_width`), and ``limit_floor`` says so.
+
 These are qcc's defaults (UWAVE-R for X-bar-R, UWAVE-SD for X-bar-S, "MR" for individuals),
 except that qcc takes d2 from a 3-decimal table (d2(2) = 1.128) where we use the exact value
 (1.1283792), so qcc's sigma differs from ours in the 4th-5th significant digit.
@@ -28,6 +32,7 @@ import numpy as np
 from station.analysis.column import Column
 from station.analysis.constants import SIGMA_MULTIPLE, c4, chart_factors, d2
 from station.analysis.descriptive import as_readings
+from station.analysis.discrimination import limit_half_width
 from station.errors import StationError
 
 LARGEST_RANGE_SUBGROUP = 10
@@ -58,6 +63,16 @@ class ControlChart:
     dispersion: Limits
     dispersion_points: Column
     message: str | None
+    limit_floor: float | None = None
+    """The least half-width the gauge step allows (1.5 steps), when a resolution was given:
+    the limits are at least this far from the centre line."""
+
+    @property
+    def floored(self) -> bool:
+        """True when the gauge step, not the within sigma, set the limits' half-width."""
+        if self.limit_floor is None or self.sigma_within is None or self.ucl is None:
+            return False
+        return SIGMA_MULTIPLE * self.sigma_within / math.sqrt(self.subgroup) < self.limit_floor
 
     @property
     def point_sigma(self) -> float | None:
@@ -179,11 +194,15 @@ def _left_out(left_over: int, size: int) -> str | None:
 
 
 def control_chart(
-    values: Iterable[float] | np.ndarray, subgroup: int = 1, kind: str | None = None
+    values: Iterable[float] | np.ndarray,
+    subgroup: int = 1,
+    kind: str | None = None,
+    resolution: float | None = None,
 ) -> ControlChart:
     """The control chart of the readings for this subgroup size (see the module docstring).
 
-    ``kind`` overrides the default chart type for the size (see :func:`chart_type`).
+    ``kind`` overrides the default chart type for the size (see :func:`chart_type`). With the
+    gauge ``resolution`` the location limits are at least 1.5 steps from the centre line.
     """
     array = as_readings(values)
     size = check_subgroup(subgroup)
@@ -209,8 +228,9 @@ def control_chart(
     spreads, spread, sigma = found
     means = array if size == 1 else subgroups(array, size).mean(axis=1)
     center = float(means.mean())
-    # X-bar +- 3 sigma / sqrt(n) is X-bar +- E2 * MR-bar, A2 * R-bar or A3 * S-bar.
-    half_width = SIGMA_MULTIPLE * sigma / math.sqrt(size)
+    # X-bar +- 3 sigma / sqrt(n) is X-bar +- E2 * MR-bar, A2 * R-bar or A3 * S-bar; never
+    # narrower than the gauge can tell apart.
+    half_width = limit_half_width(sigma, size, resolution, SIGMA_MULTIPLE)
     factors = chart_factors(size)
     lower, upper = (factors.B3, factors.B4) if kind == "Xbar-S" else (factors.D3, factors.D4)
     return ControlChart(
@@ -224,4 +244,5 @@ def control_chart(
         dispersion=Limits(spread, upper * spread, lower * spread),
         dispersion_points=Column(spreads),
         message=_left_out(array.size % size, size),
+        limit_floor=limit_half_width(0.0, size, resolution) if resolution else None,
     )

@@ -16,6 +16,8 @@ if TYPE_CHECKING:
         Normality,
         PercentileCapability,
     )
+    from station.analysis.discrimination import Discrimination
+    from station.analysis.false_alarms import FalseAlarmChance
     from station.analysis.spatial import Spatial
     from station.analysis.summary import Analysis, ChannelAnalysis
     from station.analysis.verdict import Verdict
@@ -101,8 +103,42 @@ def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
                 "lcl": json_number(chart.dispersion.lcl),
             },
             "message": chart.message,
+            "limit_floor": json_number(chart.limit_floor),
+            "floored": chart.floored,
+            "false_alarm_chance": _false_alarm_json(channel.false_alarm),
         },
+        "discrimination": _discrimination_json(channel.discrimination),
         "alarms": [_alarm_json(a, channel.alarm_is_live(a)) for a in channel.alarms],
+    }
+
+
+def _false_alarm_json(found: FalseAlarmChance | None) -> dict[str, Any] | None:
+    """The rule set's simulated false-alarm chance on a chart of this length."""
+    if found is None:
+        return None
+    return {
+        "rule_set": found.rule_set,
+        "points": found.points,
+        "chance": found.chance,
+        "standard_error": found.standard_error,
+        "at_least": found.at_least,
+        "sessions": found.sessions,
+        "simulated_points": found.simulated_points,
+        "seed": found.seed,
+        "text": found.text(),
+    }
+
+
+def _discrimination_json(found: Discrimination | None) -> dict[str, Any] | None:
+    """Whether the gauge step resolves the spread (null without a resolution)."""
+    if found is None:
+        return None
+    return {
+        "resolution": found.resolution,
+        "distinct": found.distinct,
+        "sigma_steps": json_number(found.sigma_steps),
+        "possible_ranges": found.possible_ranges,
+        "adequate": found.adequate,
     }
 
 

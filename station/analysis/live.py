@@ -24,12 +24,12 @@ more exact.
 2-sigma zone at the 10th reading may be outside it at the 30th; a truly incremental alarm list
 would have to re-judge old points whenever a limit crosses them. We split the job:
 
-* ``add()`` checks only the windows the new point completes (the last 15 points, the longest
-  pattern of any rule set) against the limits as they are now. This is O(1) and tells the
-  runner at once that "point 17 is above the upper control limit". The rules it returns are
-  exactly the batch alarms that flag the newest point of the same readings (tested at every
-  reading); their ``points`` reach back at most 15 points. Later readings move the limits and
-  may flag or clear *earlier* points: only the snapshot sees that.
+* ``add()`` checks only the windows the new point completes (the last 16 points: the longest
+  pattern of any rule set and one more) against the limits as they are now. This is O(1) and
+  tells the runner at once that "point 17 is above the upper control limit". The rules it
+  returns are exactly the batch alarms that flag the newest point of the same readings (tested
+  at every reading); their ``points`` reach back at most 16 points. Later readings move the
+  limits and may flag or clear *earlier* points: only the snapshot sees that.
 * ``snapshot()`` re-evaluates every rule over all points against the current limits, lazily
   (at most once between two readings, cached) — that is, at most once per redraw. Its alarms,
   like the whole snapshot, are exactly those of the batch :func:`summary.analyze_channel` on
@@ -59,6 +59,7 @@ from station.analysis.charts import LARGEST_RANGE_SUBGROUP, chart_type
 from station.analysis.constants import SIGMA_MULTIPLE, chart_factors
 from station.analysis.descriptive import step_multiple
 from station.analysis.diagnostics import EWMA_LAMBDA, EWMA_WIDTH, ewma_limit_half_width
+from station.analysis.discrimination import limit_half_width
 from station.analysis.phases import (
     ControlBaseline,
     FrozenLimits,
@@ -75,8 +76,12 @@ from station.analysis.summary import (
 )
 from station.errors import StationError
 
-#: The longest window any rule looks back over (15 points: report rule 3, Nelson 7).
-RULE_WINDOW = 15
+#: The points the live rules look back over: the longest pattern of any rule (15 points: report
+#: rule 3, Nelson 7) and one more. A run that goes on past its pattern then still shows the point
+#: before the newest as flagged, so the alarm overlaps the one already raised and the ledger
+#: keeps it as one alarm for the run; with exactly 15 points a 15-point rule saw only the newest
+#: point flagged and re-raised the run on every cycle.
+RULE_WINDOW = 16
 
 
 @dataclass(frozen=True)
@@ -316,7 +321,10 @@ class LiveChannel:
         center = ucl = lcl = None
         if within is not None:
             center = self._points_sum / len(self._points)
-            half_width = SIGMA_MULTIPLE * within / math.sqrt(self._subgroup)
+            # Never narrower than the gauge can tell apart, as the batch chart's.
+            half_width = limit_half_width(
+                within, self._subgroup, self.config.resolution, SIGMA_MULTIPLE
+            )
             ucl, lcl = center + half_width, center - half_width
         cp = cpu = cpl = cpk = cpk_lower = cp_within = cpk_within = None
         if self.limits is not None and n >= 2:

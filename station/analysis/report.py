@@ -316,6 +316,14 @@ def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int 
             f"CENTER {format_figure(limits_of.center, resolution)}   "
             f"LCL {format_figure(limits_of.lcl, resolution)}"
         )
+    if chart.floored and chart.limit_floor is not None:
+        lines += _wrap(
+            f"  Limits held {format_spread(chart.limit_floor, resolution)} from the centre "
+            "(1.5 gauge steps; the within sigma would put them closer): a reading one step from "
+            "the centre's nearest value is not a signal, and a reading counts beyond a zone "
+            "line only by more than half a step.",
+            width,
+        )
     if chart.message:
         lines += _wrap(f"  {chart.message}", width)
     if channel.alarms:
@@ -325,6 +333,8 @@ def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int 
             lines += _wrap(f"{rule_name(alarm.rule)} [{when}]: {alarm.text}", width, "  ")
     else:
         lines.append(f"ALARMS (rules: {config.rule_set}): none")
+    if channel.false_alarm is not None:
+        lines += _wrap(channel.false_alarm.text(), width, "  ")
     frozen = channel.frozen
     if frozen is not None:
         source = frozen.source

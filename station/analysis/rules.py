@@ -26,6 +26,13 @@ The report (§2.7.4) lists four signs without defining them further. Our reading
   a stable process does most of the time, so it cannot be a sign of trouble. The report
   follows the lettering some SPC software uses, from the centre outward.
 
+Rounded readings (a gauge ``resolution`` given): a reading y stands for every value within half a
+step of it, so it counts beyond the centre line or a 1- or 2-sigma line only when it is beyond
+by more than half a step, and within 1 sigma only when all of its half-step interval is (see
+:mod:`station.analysis.discrimination`); the 3-sigma limits themselves are held at least 1.5
+steps from the centre where they are computed. With fine readings the margin changes nothing;
+with a spread of a step or less it stops a one-step difference from raising an alarm.
+
 Alarms: one :class:`Alarm` per rule per contiguous run of flagged points on the same side;
 ``points`` lists every flagged point of that run (1-based), ``text`` is a sentence for the
 technician. Given the cycle numbers behind each point (``cycles``), an alarm also lists them and,
@@ -44,6 +51,7 @@ from typing import Any
 import numpy as np
 
 from station.analysis.descriptive import as_readings
+from station.analysis.discrimination import rounding_margin
 from station.errors import StationError
 from station.text import format_figure
 
@@ -176,10 +184,26 @@ class _Context:
     points: np.ndarray
     center: float
     sigma: float
+    margin: float = 0.0
+    """Half a gauge step: how far beyond a zone line a rounded reading must be to count."""
 
     def beyond(self, multiple: float) -> Flags:
-        line = multiple * self.sigma
+        # The control limits (3 sigma) already keep the gauge's floor; the zone lines inside
+        # them are judged with the rounding counted against the claim.
+        line = multiple * self.sigma + (self.margin if multiple < SIGMA_LIMIT else 0.0)
         return {1: self.points > self.center + line, -1: self.points < self.center - line}
+
+    def within(self, multiple: float) -> np.ndarray:
+        """Points whose whole rounding interval lies within ``multiple`` sigma of the centre
+        (inclusive, as qcc); none when the band is no wider than the rounding itself."""
+        band = multiple * self.sigma - self.margin
+        if self.margin and band <= 0:
+            return np.zeros(self.points.size, dtype=bool)
+        return np.abs(self.points - self.center) <= band
+
+
+#: The multiple of sigma the control limits sit at.
+SIGMA_LIMIT = 3.0
 
 
 def _runs(condition: np.ndarray, length: int) -> np.ndarray:
@@ -199,7 +223,7 @@ def _window_counts(condition: np.ndarray, width: int) -> np.ndarray:
 
 
 def _beyond_limits(ctx: _Context) -> Flags:
-    return ctx.beyond(3.0)
+    return ctx.beyond(SIGMA_LIMIT)
 
 
 def _k_of_m(k: int, m: int, multiple: float) -> Callable[[_Context], Flags]:
@@ -247,8 +271,7 @@ def _alternating(length: int) -> Callable[[_Context], Flags]:
 
 def _within_one_sigma(length: int) -> Callable[[_Context], Flags]:
     def rule(ctx: _Context) -> Flags:
-        inside = (ctx.points >= ctx.center - ctx.sigma) & (ctx.points <= ctx.center + ctx.sigma)
-        return {0: _runs(inside, length)}
+        return {0: _runs(ctx.within(1.0), length)}
 
     return rule
 
@@ -577,7 +600,8 @@ def check_rules(
     ``sigma`` is the sigma of the plotted statistic, (UCL - centre) / 3 (see
     ``ControlChart.point_sigma``). With no centre or sigma (a chart without limits) there is
     nothing to check and the list is empty. The control lines in the text are written at the
-    gauge ``resolution`` (one decimal beyond its step) with ``unit`` after them.
+    gauge ``resolution`` (one decimal beyond its step) with ``unit`` after them, and the zone
+    lines count the readings' rounding to that step (see the module docstring).
     ``first_point`` is the chart number of ``points[0]``: the live form checks only the last
     window of a long chart and still names the points as the chart numbers them.
     ``cycles`` gives, for each of ``points`` in order, the cycle numbers behind it (one for
@@ -598,7 +622,7 @@ def check_rules(
             f"control limits with centre {center} and sigma {sigma} cannot be checked: "
             "sigma must be a finite number >= 0"
         )
-    ctx = _Context(values, float(center), float(sigma))
+    ctx = _Context(values, float(center), float(sigma), rounding_margin(resolution))
     fmt = _formatter(resolution, unit)
     found: list[Alarm] = []
     keys: list[int] = []  # first point, then the rule's place in the set: the order shown

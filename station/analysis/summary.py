@@ -27,6 +27,8 @@ from station.analysis.charts import ControlChart, control_chart
 from station.analysis.column import Column
 from station.analysis.descriptive import Descriptive, Histogram, describe, histogram
 from station.analysis.diagnostics import (
+    ALPHA,
+    SHAPIRO_MAX_N,
     Autocorrelation,
     Drift,
     Normality,
@@ -39,6 +41,8 @@ from station.analysis.diagnostics import (
     p_phrase,
     percentile_capability,
 )
+from station.analysis.discrimination import Discrimination, discrimination
+from station.analysis.false_alarms import FalseAlarmChance, false_alarm_chance
 from station.analysis.hints import channel_hints
 from station.analysis.phases import (
     DEFAULT_FREEZE_AFTER,
@@ -156,8 +160,56 @@ class ChannelAnalysis:
     # snapshot that does not show them.
 
     @cached_property
+    def discrimination(self) -> Discrimination | None:
+        """Whether the gauge step resolves the readings' spread (None without a resolution):
+        judged on the chart's within sigma and its range (or moving-range) chart's limit."""
+        chart = self.chart
+        range_chart = {"I-MR": "moving range", "Xbar-R": "range"}.get(chart.type)
+        return discrimination(
+            self.readings.array,
+            self.resolution,
+            sigma=chart.sigma_within,
+            range_ucl=chart.dispersion.ucl if range_chart else None,
+            range_chart=range_chart or "S",
+        )
+
+    @cached_property
+    def false_alarm(self) -> FalseAlarmChance | None:
+        """The chance that a stable process raises some alarm of the rule set on a chart of
+        this many points (simulated once per chart length, cached): what an alarm is worth."""
+        rule_set, _, size, _ = self.phase_rules
+        return false_alarm_chance(rule_set, len(self.chart.points), size)
+
+    @property
+    def coarse(self) -> bool:
+        """True when the gauge step is too coarse for the spread (inadequate discrimination)."""
+        found = self.discrimination
+        return found is not None and not found.adequate
+
+    @property
+    def shape_hidden(self) -> bool:
+        """True when the rounding hides the readings' shape: no normality test, no percentile
+        index (see :attr:`Discrimination.resolves_shape`)."""
+        found = self.discrimination
+        return found is not None and not found.resolves_shape
+
+    @cached_property
     def normality(self) -> Normality | None:
-        """Shapiro-Wilk or Anderson-Darling test of the readings."""
+        """Shapiro-Wilk or Anderson-Darling test of the readings; not run (with the reason)
+        when the gauge rounded them to a few values: ties, not the process, would decide it."""
+        if self.shape_hidden:
+            found = self.discrimination
+            assert found is not None
+            n = len(self.readings)
+            return Normality(
+                "Shapiro-Wilk" if n <= SHAPIRO_MAX_N else "Anderson-Darling",
+                None,
+                None,
+                ALPHA,
+                None,
+                n,
+                message=found.shape_reason(),
+            )
         return normality(self.readings.array, self.resolution)
 
     @cached_property
@@ -203,8 +255,12 @@ class ChannelAnalysis:
     @cached_property
     def percentile(self) -> PercentileCapability | None:
         """ISO 22514-2 percentile indices when normality is rejected and limits are given
-        (None otherwise). Computed on first use: the distribution fit costs ~20 ms, too much
-        for every redraw of a live snapshot that does not show it."""
+        (None otherwise, and never from readings the gauge rounded to a few values: their
+        fitted tails are the rounding's, not the process's). Computed on first use: the
+        distribution fit costs ~20 ms, too much for every redraw of a live snapshot that does
+        not show it."""
+        if self.shape_hidden:
+            return None
         if self.normality is None or not self.normality.rejected or self.limits is None:
             return None
         return percentile_capability(self.readings.array, self.limits, self.capability.threshold)
@@ -353,7 +409,7 @@ def frozen_limits_of(name: str, values: np.ndarray, config: AnalysisConfig) -> F
         return None
 
     def chart_of(m: int) -> ControlChart:
-        return control_chart(values[: m * size], size)
+        return control_chart(values[: m * size], size, resolution=config.resolution)
 
     def usable(chart: ControlChart) -> bool:
         return chart.center is not None and chart.ucl is not None and chart.ucl > chart.center
@@ -393,7 +449,7 @@ def analyze_channel(
         lsl=None if limits is None else limits.lsl,
         usl=None if limits is None else limits.usl,
     )
-    chart = control_chart(values, config.subgroup)
+    chart = control_chart(values, config.subgroup, resolution=config.resolution)
     if limits is None:
         cap = undefined_capability(descriptive, chart, config, NO_LIMITS_MESSAGE)
     else:
@@ -466,9 +522,20 @@ def hints_of(channels: Sequence[ChannelAnalysis], config: AnalysisConfig) -> tup
 
 
 def diagnostic_hints(channel: ChannelAnalysis) -> list[str]:
-    """Hints from the checks of what the capability assumes: readings out of specification,
-    drift, autocorrelation and non-normal data."""
+    """Hints from the checks of what the capability assumes: a gauge too coarse for the spread,
+    readings out of specification, drift, autocorrelation and non-normal data."""
     hints: list[str] = []
+    found_coarse = channel.discrimination
+    coarse = (
+        None
+        if found_coarse is None
+        else found_coarse.sentence(channel.name, channel.phase_rules[1])
+    )
+    if coarse is not None:
+        hints.append(coarse)
+    # An alarm is read against how often the rules fire on a stable process of this length.
+    if channel.alarms and channel.false_alarm is not None:
+        hints.append(f"{channel.name}: {channel.false_alarm.text()}")
     found = channel.out_of_spec
     if found is not None and found.total:
         hints.append(
