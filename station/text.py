@@ -141,6 +141,20 @@ def judged_cpk(channel: Any) -> str:
     return format_index(getattr(getattr(channel, "capability", None), "cpk", None))
 
 
+def judged_count(analysis: Any) -> str:
+    """How many readings the verdict rests on, and the minimum a verdict needs: ``judged on 30
+    readings (a verdict needs 25)``; the fewest of the channels when they differ. Never the bare
+    minimum, which read as the count judged ("final from 25 readings" on 30)."""
+    counts = [
+        int(getattr(getattr(c, "descriptive", None), "n", 0) or 0)
+        for c in getattr(analysis, "channels", {}).values()
+    ]
+    n = min(counts) if counts else 0
+    minimum = analysis.config.min_n
+    noun = "reading" if n == 1 else "readings"
+    return f"judged on {n} {noun} (a verdict needs {minimum})"
+
+
 def overall_judgement(channels: Iterable[Any]) -> str:
     """The session's verdict over channel analyses: ``PROVISIONAL: k of n`` while any channel
     is below the minimum count (k its fewest readings), else :func:`overall_verdict`."""

@@ -25,7 +25,7 @@ from station.analysis.rules import number_list, rule_name
 from station.analysis.spatial import Spatial
 from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis
 from station.analysis.verdict import Verdict, confidence_text, judge_verdict
-from station.text import format_figure, format_spread
+from station.text import format_figure, format_spread, judged_count
 
 if TYPE_CHECKING:
     from station.analysis.accuracy import AccuracyAnalysis
@@ -414,7 +414,7 @@ def format_report(
     )
     lines += _wrap(
         f"Run rules: {config.rule_set}   Capable when Cpk >= {config.threshold:g}   "
-        f"Final verdict from {config.min_n} readings",
+        + judged_count(analysis).capitalize(),
         width,
     )
     for note in notes:

@@ -37,6 +37,7 @@ from station.text import (
     NOT_CAPABLE,
     format_figure,
     format_index,
+    judged_count,
     judged_cpk,
     judged_word,
     overall_judgement,
@@ -200,8 +201,7 @@ def verdict_text(view: SummaryView) -> Text:
     level = confidence_text(analysis.config.confidence)
     text.append(
         f"   (capable when Cpk's {level} lower bound ≥ {threshold:g}; (lower–upper) its "
-        f"one-sided {level} bounds, Bissell; final from "
-        f"{analysis.config.min_n} readings; unit {view.unit})\n",
+        f"one-sided {level} bounds, Bissell; {judged_count(analysis)}; unit {view.unit})\n",
         style="dim",
     )
     for name, channel in analysis.channels.items():
