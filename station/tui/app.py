@@ -21,7 +21,7 @@ import asyncio
 import signal
 import threading
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 from textual import events, work
 from textual.app import App, SystemCommand
 from textual.binding import Binding
+from textual.filter import LineFilter, Monochrome, NoColor
 from textual.geometry import Size
 from textual.screen import ModalScreen, Screen
 
@@ -54,6 +55,9 @@ if TYPE_CHECKING:
 
 REDRAW_INTERVAL = 0.1
 """Seconds between two redraws of the live screens: at most ~10 a second, whatever the rate."""
+
+_NO_COLOUR = NoColor()
+"""The filter that takes every colour off a line (``NO_COLOR``)."""
 
 HANGUP_EXIT_CODES = {signal.SIGHUP: 129, signal.SIGTERM: 143}
 
@@ -145,6 +149,17 @@ class StationApp(App[int]):
         self.sample_sink: Callable[[Any], None] | None = None
         """Hears each ``samples`` event on the writing thread (the stroke dashboard's buffer of
         the stroke under way); it must only store, never draw."""
+
+    def get_line_filters(self) -> Sequence[LineFilter]:
+        """Under ``NO_COLOR``, no colour at all: Textual's own filter turns every colour into
+        a grey of the same luminance, which still reaches the terminal as 256-colour or
+        truecolour escapes (issue 26). The station says everything by words and attributes
+        (bold, reverse video, underline), so each line takes the terminal's own foreground
+        and background instead."""
+        filters = super().get_line_filters()
+        if not self.no_color:
+            return filters
+        return [_NO_COLOUR if isinstance(each, Monochrome) else each for each in filters]
 
     # ---------------------------------------------------------------------------------------
     # Start and stop
