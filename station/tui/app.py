@@ -40,7 +40,14 @@ from station.tui.autopilot import run_autopilot
 from station.tui.instruments import running_fixture
 from station.tui.messages import RunnerChanged
 from station.tui.remedies import explained
-from station.tui.screens.dialogs import ConfirmScreen, HelpScreen, QuitQuestion, screen_keys
+from station.tui.screens.dialogs import (
+    APP_KEYS,
+    ConfirmScreen,
+    HelpScreen,
+    QuitQuestion,
+    declared_actions,
+    screen_keys,
+)
 from station.tui.screens.home import HomeScreen
 from station.tui.theme import HIGH_CONTRAST_THEME, apply_palette, wanted_theme
 from station.tui.widgets.too_small import TooSmallNotice, too_small
@@ -277,22 +284,39 @@ class StationApp(App[int]):
 
     def get_system_commands(self, screen: Screen[Any]) -> Iterable[SystemCommand]:
         """The command palette (Ctrl+P): every action of the current screen by name, with its
-        key, and this screen's keys. Textual's own entries (quit without writing
-        ``interrupted``, screenshots) are left out on purpose."""
-        seen: set[str] = set()
+        key, then Ctrl+C's Quit (unless the screen has a Quit of its own: one is enough), the
+        theme and this screen's keys. Textual's own entries (quit without writing
+        ``interrupted``, screenshots, its focus and copy keys, a list's cursor keys) are left
+        out on purpose: they are not this program's."""
+        declared = declared_actions(screen)
+        own: list[tuple[Binding, Any]] = []
+        general: list[tuple[Binding, Any]] = []
         for active in screen.active_bindings.values():
             binding = active.binding
-            if not binding.description or binding.action in seen or not active.enabled:
+            if not binding.description or not active.enabled:
                 continue
-            if binding.action in ("command_palette", "keys"):
+            if active.node is screen and binding.action in declared:
+                own.append((binding, active.node))
+            elif active.node is self and binding.action in APP_KEYS:
+                general.append((binding, active.node))
+        seen: set[str] = set()
+        named: set[str] = set()
+        for binding, node in own + general:
+            action, description = binding.action, binding.description
+            if action in seen or action in ("command_palette", "keys") or description in named:
                 continue
-            seen.add(binding.action)
-            key = self.get_key_display(binding)
+            seen.add(action)
+            named.add(description)
             yield SystemCommand(
-                binding.description,
-                f"key {key}",
-                partial(self._run_from_palette, binding.action, active.node),
+                description,
+                f"key {self.get_key_display(binding)}",
+                partial(self._run_from_palette, action, node),
             )
+        yield SystemCommand(
+            "Theme",
+            "Change the colours (station-high-contrast: black and white, for a bright workshop)",
+            self.action_change_theme,
+        )
         if screen_keys(screen):
             yield SystemCommand("Keys of this screen", "key ?", self.action_keys)
 

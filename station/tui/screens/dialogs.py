@@ -137,12 +137,33 @@ limits frozen after the first cycles, so an alarm never goes away.
 APP_KEYS = ("quit_station", "command_palette")
 """The app's own keys listed beside a screen's (Textual's built-in ones are left out)."""
 
+TEXTUAL_SCREEN_ACTIONS = frozenset(
+    binding.action for binding in Screen.BINDINGS if isinstance(binding, Binding)
+)
+"""What every Textual screen binds (Tab's focus moves, ``super+c`` copy): not this program's
+keys, whichever class declares them."""
+
+
+def declared_actions(screen: Screen[object]) -> frozenset[str]:
+    """The actions this program's own classes bind on ``screen`` (Textual's base classes,
+    ``Screen`` and ``ModalScreen``, are not this program's)."""
+    actions: set[str] = set()
+    for cls in type(screen).__mro__:
+        if cls.__module__.split(".")[0] == "textual":
+            continue
+        for binding in vars(cls).get("BINDINGS", ()):
+            action = binding.action if isinstance(binding, Binding) else binding[1]
+            actions.add(action)
+    return frozenset(actions - TEXTUAL_SCREEN_ACTIONS)
+
 
 def screen_keys(screen: Screen[object]) -> list[tuple[str, str]]:
     """The keys ``screen`` answers now: its own first, in the footer's order, then Ctrl+C;
     a list's or a field's own movement keys are left out (they are the same everywhere), as
-    are keys without a description (they repeat one that has it, e.g. ``x`` beside Tab)."""
+    are keys without a description (they repeat one that has it, e.g. ``x`` beside Tab) and
+    Textual's own keys of every screen (focus moves, copy)."""
     app = screen.app
+    declared = declared_actions(screen)
     own: list[tuple[str, str]] = []
     general: list[tuple[str, str]] = []
     seen: set[str] = set()
@@ -150,7 +171,7 @@ def screen_keys(screen: Screen[object]) -> list[tuple[str, str]]:
         binding = active.binding
         if not binding.description or binding.action in seen or not active.enabled:
             continue
-        if active.node is screen:
+        if active.node is screen and binding.action in declared:
             own.append((app.get_key_display(binding), binding.description))
         elif active.node is app and binding.action in APP_KEYS:
             general.append((app.get_key_display(binding), binding.description))
