@@ -21,7 +21,7 @@ import asyncio
 import signal
 import threading
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 from textual import events, work
 from textual.app import App, SystemCommand
 from textual.binding import Binding
+from textual.filter import LineFilter, Monochrome, NoColor
 from textual.geometry import Size
 from textual.screen import ModalScreen, Screen
 
@@ -39,7 +40,14 @@ from station.tui.autopilot import run_autopilot
 from station.tui.instruments import running_fixture
 from station.tui.messages import RunnerChanged
 from station.tui.remedies import explained
-from station.tui.screens.dialogs import ConfirmScreen, HelpScreen, QuitQuestion, screen_keys
+from station.tui.screens.dialogs import (
+    APP_KEYS,
+    ConfirmScreen,
+    HelpScreen,
+    QuitQuestion,
+    declared_actions,
+    screen_keys,
+)
 from station.tui.screens.home import HomeScreen
 from station.tui.theme import HIGH_CONTRAST_THEME, apply_palette, wanted_theme
 from station.tui.widgets.too_small import TooSmallNotice, too_small
@@ -54,6 +62,9 @@ if TYPE_CHECKING:
 
 REDRAW_INTERVAL = 0.1
 """Seconds between two redraws of the live screens: at most ~10 a second, whatever the rate."""
+
+_NO_COLOUR = NoColor()
+"""The filter that takes every colour off a line (``NO_COLOR``)."""
 
 HANGUP_EXIT_CODES = {signal.SIGHUP: 129, signal.SIGTERM: 143}
 
@@ -145,6 +156,17 @@ class StationApp(App[int]):
         self.sample_sink: Callable[[Any], None] | None = None
         """Hears each ``samples`` event on the writing thread (the stroke dashboard's buffer of
         the stroke under way); it must only store, never draw."""
+
+    def get_line_filters(self) -> Sequence[LineFilter]:
+        """Under ``NO_COLOR``, no colour at all: Textual's own filter turns every colour into
+        a grey of the same luminance, which still reaches the terminal as 256-colour or
+        truecolour escapes (issue 26). The station says everything by words and attributes
+        (bold, reverse video, underline), so each line takes the terminal's own foreground
+        and background instead."""
+        filters = super().get_line_filters()
+        if not self.no_color:
+            return filters
+        return [_NO_COLOUR if isinstance(each, Monochrome) else each for each in filters]
 
     # ---------------------------------------------------------------------------------------
     # Start and stop
@@ -262,22 +284,39 @@ class StationApp(App[int]):
 
     def get_system_commands(self, screen: Screen[Any]) -> Iterable[SystemCommand]:
         """The command palette (Ctrl+P): every action of the current screen by name, with its
-        key, and this screen's keys. Textual's own entries (quit without writing
-        ``interrupted``, screenshots) are left out on purpose."""
-        seen: set[str] = set()
+        key, then Ctrl+C's Quit (unless the screen has a Quit of its own: one is enough), the
+        theme and this screen's keys. Textual's own entries (quit without writing
+        ``interrupted``, screenshots, its focus and copy keys, a list's cursor keys) are left
+        out on purpose: they are not this program's."""
+        declared = declared_actions(screen)
+        own: list[tuple[Binding, Any]] = []
+        general: list[tuple[Binding, Any]] = []
         for active in screen.active_bindings.values():
             binding = active.binding
-            if not binding.description or binding.action in seen or not active.enabled:
+            if not binding.description or not active.enabled:
                 continue
-            if binding.action in ("command_palette", "keys"):
+            if active.node is screen and binding.action in declared:
+                own.append((binding, active.node))
+            elif active.node is self and binding.action in APP_KEYS:
+                general.append((binding, active.node))
+        seen: set[str] = set()
+        named: set[str] = set()
+        for binding, node in own + general:
+            action, description = binding.action, binding.description
+            if action in seen or action in ("command_palette", "keys") or description in named:
                 continue
-            seen.add(binding.action)
-            key = self.get_key_display(binding)
+            seen.add(action)
+            named.add(description)
             yield SystemCommand(
-                binding.description,
-                f"key {key}",
-                partial(self._run_from_palette, binding.action, active.node),
+                description,
+                f"key {self.get_key_display(binding)}",
+                partial(self._run_from_palette, action, node),
             )
+        yield SystemCommand(
+            "Theme",
+            "Change the colours (station-high-contrast: black and white, for a bright workshop)",
+            self.action_change_theme,
+        )
         if screen_keys(screen):
             yield SystemCommand("Keys of this screen", "key ?", self.action_keys)
 

@@ -3,9 +3,11 @@
 Under ``NO_COLOR`` Textual turns every colour into a grey of the same luminance, so "bold red"
 on a dark background became grey 237 on 234 (issue 13): the verdict vanished. The verdict and
 alarm styles here therefore carry their meaning in text attributes (bold, reverse video,
-underline) and, without colour, name no colour at all, so they take the theme's foreground,
-which keeps its contrast. ``STATION_THEME=high-contrast`` picks a black-and-white theme with the
-same attributes for a washed-out screen in a bright workshop.
+underline) and, without colour, name no colour at all; and the app draws no colour at all
+under ``NO_COLOR`` (``StationApp.get_line_filters``: the terminal's own foreground and
+background, issue 26), so the attributes are what is left, and they read.
+``STATION_THEME=high-contrast`` picks a black-and-white theme with the same attributes for a
+washed-out screen in a bright workshop.
 
 Front ends import ``VERDICT_STYLES`` and ``ALARM_STYLES`` from here; :func:`apply_palette`
 fills them in place when the app starts, so every screen agrees.

@@ -142,3 +142,55 @@ def test_station_read_refuses_its_own_terminal(tmp_path: Path) -> None:
             read.close()
     assert code == 2, errors.read_text()
     assert "is this station's own terminal, not a gauge line" in errors.read_text()
+
+
+_SGR = re.compile(rb"\x1b\[([0-9;:]*)m")
+
+
+def colour_escapes(output: bytes) -> list[str]:
+    """Every colour the terminal was told to draw in: 256-colour and truecolour (``38;5;N``,
+    ``48;2;R;G;B``) and the sixteen ANSI colours; the terminal's own colours (39, 49) are not
+    a colour."""
+    found = []
+    for match in _SGR.finditer(output):
+        parameters = [int(p or 0) for p in match.group(1).decode().replace(":", ";").split(";")]
+        index = 0
+        while index < len(parameters):
+            parameter = parameters[index]
+            if parameter in (38, 48, 58):
+                width = {5: 3, 2: 5}.get(
+                    parameters[index + 1] if index + 1 < len(parameters) else 0, 1
+                )
+                found.append(";".join(map(str, parameters[index : index + width])))
+                index += width
+                continue
+            if 30 <= parameter <= 37 or 40 <= parameter <= 47 or 90 <= parameter <= 107:
+                found.append(str(parameter))
+            index += 1
+    return found
+
+
+def test_colour_escapes_are_found() -> None:
+    """The check below can fail: it sees the greys Textual drew under NO_COLOR."""
+    assert colour_escapes(b"\x1b[1;38;5;237;48;5;234mPASS\x1b[39;49m") == ["38;5;237", "48;5;234"]
+    assert colour_escapes(b"\x1b[38;2;1;2;3m\x1b[31m\x1b[1;7;39;49m") == ["38;2;1;2;3", "31"]
+
+
+def test_no_color_draws_no_colour_in_a_real_terminal(tmp_path: Path, monkeypatch) -> None:
+    """Issue 26: with ``NO_COLOR=1`` the station drew 256-colour greys. The demo walks home,
+    set-up, checklist, dashboard and summary on a real pseudo-terminal: no colour escape in
+    any byte it wrote, and the verdict is there in words."""
+    monkeypatch.setenv("NO_COLOR", "1")
+    command = [sys.executable, "-m", "station", "demo", "--autopilot", "--count", "3"]
+    station = PtyProcess(
+        [*command, "--pace", "0.05", "--sessions", str(tmp_path)],
+        tmp_path,
+    )
+    try:
+        station.wait_for("Verdict", timeout=180)
+        station.wait_for("Export report", timeout=20)
+        output = bytes(station.output)
+    finally:
+        station.close()
+    assert b"Capture" in output and b"Confirm step" in output  # the dashboard, the checklist
+    assert colour_escapes(output) == []

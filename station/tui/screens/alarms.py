@@ -24,7 +24,7 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Vertical
 from textual.screen import ModalScreen, Screen
-from textual.widgets import Footer, Input, ListItem, ListView, OptionList, Static
+from textual.widgets import Input, ListItem, ListView, OptionList, Static
 
 from station.errors import StationError
 from station.procedures import DEFAULT_CAUSES, OTHER_CAUSE
@@ -42,6 +42,7 @@ from station.tui.widgets.fields import (
     field_key_active,
     focused_field,
 )
+from station.tui.widgets.key_footer import KeyFooter
 
 
 def alarm_text(alarm: RecordedAlarm, *, hint: bool = True) -> Text:
@@ -97,7 +98,7 @@ class AckDialog(ModalScreen[AckRequest | None]):
             yield FieldInput(placeholder="corrective action (optional)", id="ack-action")
             yield Static("", id="ack-error")
             yield Static("Enter on the action saves · Escape cancels", classes="dim")
-        yield Footer()
+        yield KeyFooter()
 
     def on_mount(self) -> None:
         """Start on the first cause."""
@@ -198,7 +199,7 @@ class AlarmsScreen(Screen[None]):
         yield ListView(
             *[AlarmItem(alarm, hint=not self.read_only) for alarm in self.alarms], id="alarm-list"
         )
-        yield Footer()
+        yield KeyFooter()
 
     def _title(self) -> Text:
         open_count = sum(not alarm.acknowledged for alarm in self.alarms)

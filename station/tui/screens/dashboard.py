@@ -19,7 +19,7 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal
 from textual.screen import Screen
-from textual.widgets import Footer, Static
+from textual.widgets import Static
 
 from station.errors import StationError
 from station.text import format_figure
@@ -31,6 +31,7 @@ from station.tui.widgets.alarm_log import AlarmLog, alarm_lines, recorded_alarm_
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.histogram import HistogramView, histogram_data
 from station.tui.widgets.instrument_status import InstrumentStatus
+from station.tui.widgets.key_footer import KeyFooter
 from station.tui.widgets.stats_panel import StatsPanel, StatsRows
 
 if TYPE_CHECKING:
@@ -173,13 +174,13 @@ class DashboardScreen(Screen[None]):
         Binding("p", "pause", "Pause"),
         Binding("f", "finish", "Finish"),
         Binding("a", "alarms", "Alarms"),
+        Binding("m", "full_text", "Messages"),
         Binding("tab", "next_axis", "Axis", key_display="xyz"),
         Binding("x", "axis('x')", "x", show=False),
         Binding("y", "axis('y')", "y", show=False),
         Binding("z", "axis('z')", "z", show=False),
         Binding("f1", "help", "Help"),
         Binding("question_mark", "help", "Help", show=False),
-        Binding("m", "full_text", "Messages in full", show=False),
         Binding("q", "leave", "Leave"),
         Binding("escape", "back", "Back", show=False),
     ]
@@ -224,7 +225,7 @@ class DashboardScreen(Screen[None]):
         yield AlarmLog(id="dash-alarms")
         yield InstrumentStatus(id="dash-instruments")
         yield Static(id="dash-message")
-        yield Footer()
+        yield KeyFooter()
 
     def on_mount(self) -> None:
         """Draw the newest state (live) or the saved session (review)."""

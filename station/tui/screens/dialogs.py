@@ -7,10 +7,11 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Vertical, VerticalScroll
 from textual.screen import ModalScreen, Screen
-from textual.widgets import Footer, Input, Static
+from textual.widgets import Input, Static
 
 from station.tui.text import shown
 from station.tui.widgets.fields import FieldInput, say
+from station.tui.widgets.key_footer import KeyFooter
 
 
 class TextPrompt(ModalScreen[str | None]):
@@ -32,7 +33,7 @@ class TextPrompt(ModalScreen[str | None]):
             yield FieldInput(placeholder=self._placeholder, id="prompt-input")
             yield Static("", classes="field-error", id="prompt-error")
             yield Static("Enter to save · Escape to cancel", classes="dim")
-        yield Footer()
+        yield KeyFooter()
 
     def on_mount(self) -> None:
         """Focus the input."""
@@ -73,7 +74,7 @@ class ConfirmScreen(ModalScreen[bool]):
             if self._detail:
                 yield Static(shown(self._detail))
             yield Static("y = yes · n = no", classes="dim")
-        yield Footer()
+        yield KeyFooter()
 
     def action_answer(self, answer: bool) -> None:
         """Close with the answer."""
@@ -103,8 +104,10 @@ HELP_TEXT = """\
   g go on to the next step (once the step has its minimum, e.g. the
   next joint) · a the alarm list: acknowledge an alarm with a cause
   from the procedure's list, what it was and the corrective action
-  A reading beyond a limit is marked ▲ (above the USL) or ▼ (below
-  the LSL) at once; the column "out" counts them per axis.
+  m the newest message and every alarm in full (their lines here are
+  cut to the width). A reading beyond a limit is marked ▲ (above the
+  USL) or ▼ (below the LSL) at once; the column "out" counts them per
+  axis.
 
 [b]Strokes[/b]  (linearity) the strokes stream as the robot shuttles
   A↔B · e end the stroke now (Space streams again) · f finish
@@ -137,12 +140,33 @@ limits frozen after the first cycles, so an alarm never goes away.
 APP_KEYS = ("quit_station", "command_palette")
 """The app's own keys listed beside a screen's (Textual's built-in ones are left out)."""
 
+TEXTUAL_SCREEN_ACTIONS = frozenset(
+    binding.action for binding in Screen.BINDINGS if isinstance(binding, Binding)
+)
+"""What every Textual screen binds (Tab's focus moves, ``super+c`` copy): not this program's
+keys, whichever class declares them."""
+
+
+def declared_actions(screen: Screen[object]) -> frozenset[str]:
+    """The actions this program's own classes bind on ``screen`` (Textual's base classes,
+    ``Screen`` and ``ModalScreen``, are not this program's)."""
+    actions: set[str] = set()
+    for cls in type(screen).__mro__:
+        if cls.__module__.split(".")[0] == "textual":
+            continue
+        for binding in vars(cls).get("BINDINGS", ()):
+            action = binding.action if isinstance(binding, Binding) else binding[1]
+            actions.add(action)
+    return frozenset(actions - TEXTUAL_SCREEN_ACTIONS)
+
 
 def screen_keys(screen: Screen[object]) -> list[tuple[str, str]]:
     """The keys ``screen`` answers now: its own first, in the footer's order, then Ctrl+C;
     a list's or a field's own movement keys are left out (they are the same everywhere), as
-    are keys without a description (they repeat one that has it, e.g. ``x`` beside Tab)."""
+    are keys without a description (they repeat one that has it, e.g. ``x`` beside Tab) and
+    Textual's own keys of every screen (focus moves, copy)."""
     app = screen.app
+    declared = declared_actions(screen)
     own: list[tuple[str, str]] = []
     general: list[tuple[str, str]] = []
     seen: set[str] = set()
@@ -150,7 +174,7 @@ def screen_keys(screen: Screen[object]) -> list[tuple[str, str]]:
         binding = active.binding
         if not binding.description or binding.action in seen or not active.enabled:
             continue
-        if active.node is screen:
+        if active.node is screen and binding.action in declared:
             own.append((app.get_key_display(binding), binding.description))
         elif active.node is app and binding.action in APP_KEYS:
             general.append((app.get_key_display(binding), binding.description))
@@ -183,7 +207,7 @@ class HelpScreen(ModalScreen[None]):
                     text.append("  ^p           every action of this screen by name\n")
                 yield Static(text, id="help-keys")
             yield Static(HELP_TEXT)
-        yield Footer()
+        yield KeyFooter()
 
     def action_close(self) -> None:
         """Back to the screen underneath."""
@@ -210,7 +234,7 @@ class FullTextScreen(ModalScreen[None]):
             yield Static(shown(self._title, style="bold"), classes="dialog-title")
             body = "\n\n".join(self._lines) if self._lines else "Nothing to show yet."
             yield Static(shown(body), id="full-text")
-        yield Footer()
+        yield KeyFooter()
 
     def action_close(self) -> None:
         """Back to the screen underneath."""

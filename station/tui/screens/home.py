@@ -15,7 +15,7 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Vertical
 from textual.screen import Screen
-from textual.widgets import Footer, OptionList, Static
+from textual.widgets import OptionList, Static
 from textual.widgets.option_list import Option
 
 from station.errors import StationError
@@ -23,6 +23,7 @@ from station.session.store import find_unfinished, list_sessions
 from station.tui.remedies import explained
 from station.tui.screens.dialogs import HelpScreen
 from station.tui.text import shown, shown_line
+from station.tui.widgets.key_footer import KeyFooter
 
 if TYPE_CHECKING:
     from station.tui.app import StationApp
@@ -73,7 +74,7 @@ class HomeScreen(Screen[None]):
                 )
             yield OptionList(id="home-choices")
             yield Static(id="home-folder")
-        yield Footer()
+        yield KeyFooter()
 
     def on_mount(self) -> None:
         """Fill the choices from the sessions folder."""

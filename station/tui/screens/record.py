@@ -13,11 +13,12 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import VerticalScroll
 from textual.screen import Screen
-from textual.widgets import Footer, Static
+from textual.widgets import Static
 
 from station.errors import StationError
 from station.tui.remedies import explained
 from station.tui.text import shown
+from station.tui.widgets.key_footer import KeyFooter
 
 if TYPE_CHECKING:
     from station.tui.app import StationApp
@@ -40,7 +41,7 @@ class RecordScreen(Screen[None]):
         yield Static(shown(self._title, style="bold", limit=200), id="record-title")
         with VerticalScroll(id="record-body"):
             yield Static(Text("Working it out ...", style="yellow"), id="record-text")
-        yield Footer()
+        yield KeyFooter()
 
     def on_mount(self) -> None:
         """Compute the lines off the UI thread (it reads and analyses session files)."""

@@ -16,7 +16,7 @@ from textual import work
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.screen import Screen
-from textual.widgets import DataTable, Footer, Static
+from textual.widgets import DataTable, Static
 
 from station.errors import StationError
 from station.session.store import list_sessions, status_words
@@ -25,6 +25,7 @@ from station.tui.screens.dialogs import HelpScreen, TextPrompt
 from station.tui.screens.summary import SummaryScreen, SummaryView
 from station.tui.text import shown, shown_line
 from station.tui.theme import VERDICT_STYLES
+from station.tui.widgets.key_footer import KeyFooter
 
 if TYPE_CHECKING:
     from station.tui.app import StationApp
@@ -59,7 +60,7 @@ class ReviewScreen(Screen[None]):
         yield Static(Text("Saved sessions, by robot and date", style="bold"), id="review-title")
         yield DataTable(id="review-table", cursor_type="row", zebra_stripes=True)
         yield Static(id="review-folder")
-        yield Footer()
+        yield KeyFooter()
 
     def on_mount(self) -> None:
         """List the folder."""

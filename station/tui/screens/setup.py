@@ -19,7 +19,7 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, VerticalScroll
 from textual.widget import Widget
-from textual.widgets import Button, Footer, Input, Select, Static
+from textual.widgets import Button, Input, Select, Static
 
 from station.errors import StationError
 from station.plain import plain
@@ -45,6 +45,7 @@ from station.tui.screens.setup_form import (
 )
 from station.tui.text import shown
 from station.tui.widgets.fields import FIELD_KEYS, field_key_active, mark_focused_row, say
+from station.tui.widgets.key_footer import KeyFooter
 
 if TYPE_CHECKING:
     from station.procedures import Procedure
@@ -141,7 +142,7 @@ class SetupScreen(ConnectionTestScreen):
                 variant="primary",
                 compact=True,
             )
-        yield Footer()
+        yield KeyFooter()
 
     def _select(self, field_id: str, options: Any, value: str, **options_kw: Any) -> Select:
         """A compact Select that remembers its initial value (see :meth:`_value`)."""

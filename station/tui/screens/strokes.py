@@ -25,7 +25,7 @@ from textual.binding import Binding
 from textual.containers import Horizontal
 from textual.message import Message
 from textual.screen import Screen
-from textual.widgets import Footer, Static
+from textual.widgets import Static
 
 from station.analysis.linearity import least_squares_line
 from station.errors import StationError
@@ -39,6 +39,7 @@ from station.tui.widgets.alarm_log import AlarmLog, alarm_lines
 from station.tui.widgets.control_chart import ControlChartView, chart_data
 from station.tui.widgets.deviation_plot import DeviationData, DeviationPlot, trace
 from station.tui.widgets.instrument_status import InstrumentStatus
+from station.tui.widgets.key_footer import KeyFooter
 from station.tui.widgets.stats_panel import StatsPanel, StatsRows
 
 if TYPE_CHECKING:
@@ -140,7 +141,7 @@ class StrokeDashboardScreen(Screen[None]):
         yield AlarmLog(id="dash-alarms")
         yield InstrumentStatus(id="dash-instruments")
         yield Static(id="dash-message")
-        yield Footer()
+        yield KeyFooter()
 
     def on_mount(self) -> None:
         """Hear the stream's points, draw, and start streaming."""

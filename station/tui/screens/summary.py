@@ -23,7 +23,7 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import VerticalScroll
 from textual.screen import Screen
-from textual.widgets import Footer, Static
+from textual.widgets import Static
 
 from station.analysis.rules import rule_name
 from station.analysis.verdict import confidence_text
@@ -47,6 +47,7 @@ from station.tui.remedies import explained
 from station.tui.screens.dialogs import HelpScreen
 from station.tui.text import shown, shown_line
 from station.tui.theme import VERDICT_STYLES
+from station.tui.widgets.key_footer import KeyFooter
 
 if TYPE_CHECKING:
     from station.run import RunnerState
@@ -396,7 +397,7 @@ class SummaryScreen(Screen[None]):
             yield Static(file_text(self.view, self.exported), id="summary-file")
         # Exports and refusals are said on this line, not in toasts over the verdict.
         yield Static("", id="summary-message")
-        yield Footer()
+        yield KeyFooter()
 
     def notify(
         self, message: str, *, severity: str = "information", markup: bool = True, **_: Any
