@@ -245,3 +245,94 @@ async def test_every_key_in_view_while_streaming_strokes(tmp_path: Path, monkeyp
             assert_every_key_in_view(app, "e End stroke", "f Finish", "f1 Help", "q Leave")
     finally:
         lab.stop()
+
+
+# ---- the texts that were cut at 80 columns ------------------------------------------------------
+
+
+async def test_the_review_lists_last_column_is_in_view(tmp_path: Path, tui) -> None:
+    """A long robot name beside a crashed session's state pushed "done" off the screen."""
+    from station.tui.screens.review import ReviewScreen
+    from tests.tui.conftest import screen_text
+    from tests.tui.test_operator import _write
+
+    robot = "KUKA-KR16-2-cell-3-line-B"
+    _write(tmp_path, robot, 30, "finish", 1)
+    _write(tmp_path, robot, 7, None, 2)  # the writer went away without a word: a crash
+    app = _app(tmp_path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("v")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, ReviewScreen))
+        verdicts = ("CAPABLE", "INCONCLUSIVE", "PROVISIONAL", "UNDEFINED")
+        await tui.wait_until(pilot, lambda: any(v in screen_text(app) for v in verdicts))
+        await pilot.pause(0.2)
+        drawn = screen_text(app)
+        words = " ".join(drawn.split())
+        for whole in ("done", "30/30", "7/30", "cycles", "(crashed?)", "repeatability"):
+            assert whole in words, drawn
+        # Wrapped where narrowed, never cut: every word of the crashed state is there.
+        for part in ("stopped", "without", "word", robot[:8]):
+            assert part in drawn, drawn
+
+
+async def test_the_home_screen_keeps_its_folder_sentence_in_view(tmp_path: Path, tui) -> None:
+    """In the demo, at 80×24, the banner and the demo's choices pushed the sessions folder off
+    the screen: the choices scroll now, and the folder is said."""
+    from station.tui.app import DemoPort
+    from station.tui.instruments import DemoLab
+    from station.tui.screens.home import HomeScreen
+    from tests.tui.conftest import screen_text
+
+    app = StationApp(
+        StationConfig(
+            sessions_dir=tmp_path,
+            sessions_reason="the demo's own folder",
+            demo=DemoPort(url="/dev/pts/99", protocol="mitutoyo", channel_map={"1": "x"}),
+            demo_lab=DemoLab(1990),  # its simulators start only when a procedure is chosen
+        )
+    )
+    async with app.run_test(size=(80, 24)) as pilot:
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, HomeScreen))
+        await pilot.pause(0.3)
+        drawn = screen_text(app)
+        words = " ".join(drawn.split())  # the path may wrap at the screen's edge
+        assert f"Sessions folder: {tmp_path}" in words, drawn
+        assert "(the demo's own folder)" in drawn, drawn
+        assert "New session" in drawn, drawn
+
+
+async def test_the_checklists_step_names_wrap_in_its_list(tui) -> None:
+    """The step list is 38 columns wide at 80×24 (as station.tcss lays out the checklist):
+    a long step name wraps under itself instead of ending in "…"."""
+    from types import SimpleNamespace
+
+    from textual.app import App, ComposeResult
+    from textual.containers import VerticalScroll
+
+    from station.tui.widgets.step_list import StepList
+    from tests.tui.conftest import screen_text
+
+    titles = ("Fit the cube", "Bring the cube into the second fixture", "Zero the scale")
+    steps = [
+        SimpleNamespace(
+            mark=mark, step=SimpleNamespace(title=title), id=f"s{n}", placement=1 if n else None
+        )
+        for n, (mark, title) in enumerate(zip(("done", "current", "pending"), titles, strict=True))
+    ]
+
+    class Steps(App[None]):
+        CSS_PATH = str(Path(__file__).resolve().parents[2] / "station/tui/station.tcss")
+
+        def compose(self) -> ComposeResult:
+            with VerticalScroll(id="steps-box"):
+                yield StepList(id="steps")
+
+    app = Steps()
+    async with app.run_test(size=(80, 24)) as pilot:
+        app.query_one(StepList).show(steps)
+        await pilot.pause(0.1)
+        drawn = screen_text(app)
+        assert "…" not in drawn, drawn
+        words = " ".join(drawn.replace("│", " ").split())
+        assert "2 Bring the cube into the second fixture (1)" in words, drawn
+        assert "3 Zero the scale (1)" in words, drawn

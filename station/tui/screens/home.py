@@ -11,9 +11,11 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from rich.text import Text
+from textual import events
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Vertical
+from textual.css.scalar import Scalar
 from textual.screen import Screen
 from textual.widgets import OptionList, Static
 from textual.widgets.option_list import Option
@@ -34,6 +36,9 @@ INTRODUCTION = (
     "with mean, σ, skewness, histogram, control chart and Cp/Cpk. ↑ ↓ and Enter choose."
 )
 
+
+CHOICES_ROWS = 10
+"""The most rows the box of choices takes (borders included) when the screen has room."""
 
 RESUME_OFFERED = 5
 """Unfinished sessions offered on the home screen before the rest are summed up in one line:
@@ -124,11 +129,26 @@ class HomeScreen(Screen[None]):
         choices.add_option(Option("Quit", id="quit"))
         choices.highlighted = 0
         choices.focus()
+        self.call_after_refresh(self._fit_choices)
         folder = shown(f"Sessions folder: {shown_line(config.sessions_dir)}", style="dim")
         folder.append(f"\n({shown_line(config.sessions_reason)})", style="dim")
         if self._load_error:
             folder.append(f"\n{shown_line(self._load_error, limit=None)}", style="bold red")
         self.query_one("#home-folder", Static).update(folder)
+
+    def _fit_choices(self) -> None:
+        """The choices take the rows their options need, up to :data:`CHOICES_ROWS`, and no
+        more than are left above the folder sentence: at 80×24 in the demo the list scrolls
+        and the folder stays in view (it was pushed off the screen, issue 26)."""
+        choices = self.query_one("#home-choices", OptionList)
+        rows = choices.virtual_size.height + choices.styles.gutter.height
+        wanted = max(3, min(CHOICES_ROWS, rows))
+        if choices.styles.max_height != Scalar.from_number(wanted):
+            choices.styles.max_height = wanted
+
+    def on_resize(self, event: events.Resize) -> None:
+        """Options wrap differently at another width."""
+        self.call_after_refresh(self._fit_choices)
 
     def on_option_list_option_selected(self, event: OptionList.OptionSelected) -> None:
         """Enter on a choice."""

@@ -8,9 +8,11 @@ left). ``/`` shows one robot's sessions.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from rich.cells import cell_len
 from rich.text import Text
 from textual import work
 from textual.app import ComposeResult
@@ -29,6 +31,43 @@ from station.tui.widgets.key_footer import KeyFooter
 
 if TYPE_CHECKING:
     from station.tui.app import StationApp
+
+
+COLUMNS = (
+    ("robot", "robot"),
+    ("created (UTC)", "created"),
+    ("verdict / state", "verdict"),
+    ("procedure", "procedure"),
+    ("done", "cycles"),
+)
+"""The list's columns: label and key."""
+COLUMN_GUTTER = 2
+"""Cells a column takes beside its text (the table's padding, one on each side)."""
+SCROLLBAR = 2
+"""Cells kept for the list's scroll bar."""
+VERDICT_ROOM = max(map(cell_len, VERDICT_STYLES))
+"""The verdict column is wide enough for any verdict word (they are filled in later)."""
+NARROWEST_ROBOT = 12
+"""The fewest cells the robot column keeps when the columns are too wide together."""
+
+
+def column_widths(rows: Sequence[Sequence[Text]], room: int) -> list[int]:
+    """Each column's width: its widest cell or label; then, while they take more than
+    ``room`` cells together, narrowed in turn where wrapping reads best: the robot (free text)
+    down to :data:`NARROWEST_ROBOT`, the verdict or state down to its label, what was done
+    down to its label, the procedure (one word) last; the date never."""
+    widths = [cell_len(label) for label, _key in COLUMNS]
+    for cells in rows:
+        for index, cell in enumerate(cells):
+            widths[index] = max(widths[index], cell.cell_len)
+    widths[2] = max(widths[2], VERDICT_ROOM)
+    floors = {0: NARROWEST_ROBOT, 2: cell_len(COLUMNS[2][0]), 4: 8, 3: cell_len(COLUMNS[3][0])}
+    for index, floor in floors.items():
+        excess = sum(widths) - room
+        if excess <= 0:
+            break
+        widths[index] = max(min(floor, widths[index]), widths[index] - excess)
+    return widths
 
 
 class ReviewScreen(Screen[None]):
@@ -68,13 +107,6 @@ class ReviewScreen(Screen[None]):
         folder = self.app.config.sessions_dir
         self._all = list(list_sessions(folder))
         table = self.query_one(DataTable)
-        # A finished session's verdict and an unfinished one's state share a column: one of
-        # them is all a row has, and both fit 80 columns beside the robot and the date.
-        table.add_column("robot", key="robot")
-        table.add_column("created (UTC)", key="created")
-        table.add_column("verdict / state", key="verdict")
-        table.add_column("procedure", key="procedure")
-        table.add_column("done", key="cycles")
         self._fill()
         table.focus()
         finished = [s.path for s in self._all if not s.error and s.status == "finished"]
@@ -85,28 +117,48 @@ class ReviewScreen(Screen[None]):
         """The rows of the sessions the robot filter lets through."""
 
         table = self.query_one(DataTable)
-        table.clear()
+        row = table.cursor_row
         wanted = self._robot_filter.casefold()
         self._sessions = [
             s for s in self._all if not wanted or wanted in (s.robot or "").casefold()
         ]
-        for index, summary in enumerate(self._sessions):
+        rows: list[tuple[Text, ...]] = []
+        for summary in self._sessions:
             if summary.error:
-                table.add_row(
-                    shown(summary.path.name, limit=120), "", "unreadable", "", "", key=str(index)
-                )
+                blank = Text("")
+                name = shown(summary.path.name, limit=120)
+                rows.append((name, blank, Text("unreadable"), blank, blank))
                 continue
             cycles = summary.progress_brief
             if summary.rejected:
                 cycles += f" ({summary.rejected} rej.)"
-            table.add_row(
-                shown(summary.robot, limit=60),
-                shown(summary.created[:16].replace("T", " ")),
-                self._verdict_cell(summary),
-                shown(summary.procedure, limit=60),
-                cycles,
-                key=str(index),
+            rows.append(
+                (
+                    shown(summary.robot, limit=60),
+                    shown(summary.created[:16].replace("T", " ")),
+                    self._verdict_cell(summary),
+                    shown(summary.procedure, limit=60),
+                    Text(cycles),
+                )
             )
+        table.clear(columns=True)
+        # A finished session's verdict and an unfinished one's state share a column: one of
+        # them is all a row has. Columns too wide for the terminal together are narrowed and
+        # their cells wrap, so the last one is never cut off at the screen's edge.
+        room = self.app.size.width - COLUMN_GUTTER * len(COLUMNS) - SCROLLBAR
+        widths = column_widths(rows, room)
+        for (label, key), width in zip(COLUMNS, widths, strict=True):
+            table.add_column(label, key=key, width=width)
+        # A robot (or a file name) of 60 characters in a narrowed column would be a row of
+        # five lines and push the others off the screen: two lines' worth, then an ellipsis.
+        most = 2 * widths[0]
+        for index, cells in enumerate(rows):
+            first = cells[0]
+            if first.cell_len > most:
+                first = first[: most - 1] + Text("…")
+            table.add_row(first, *cells[1:], key=str(index), height=None)
+        if 0 <= row < len(rows):
+            table.move_cursor(row=row)
         folder = self.app.config.sessions_dir
         note = f"{len(self._all)} session(s) in {folder}"
         if self._robot_filter:
@@ -117,6 +169,11 @@ class ReviewScreen(Screen[None]):
         if not self._all:
             note = f"No session files in {folder} yet."
         self.query_one("#review-folder", Static).update(shown(note, style="dim"))
+
+    def on_resize(self, event: Any) -> None:
+        """Another width: the columns are fitted to it again."""
+        if self._all:
+            self._fill()
 
     def _verdict_cell(self, summary: Any) -> Text:
 
