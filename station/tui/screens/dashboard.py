@@ -240,6 +240,8 @@ class DashboardScreen(Screen[None]):
 
     def show_state(self, state: RunnerState) -> None:
         """Redraw from a runner snapshot and the live analysis (UI thread)."""
+        if not self.query(HistogramView):
+            return  # its widgets are being taken down (the screen or the app is leaving)
         may_go_on = state.action.kind == "capture" and state.action.may_confirm
         if may_go_on != self._may_go_on:
             self._may_go_on = may_go_on

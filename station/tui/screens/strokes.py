@@ -168,6 +168,8 @@ class StrokeDashboardScreen(Screen[None]):
 
     def show_state(self, state: RunnerState) -> None:
         """Redraw from a runner snapshot and the newest stroke analysis (UI thread)."""
+        if not self.query("#dash-title"):
+            return  # its widgets are being taken down (the screen or the app is leaving)
         header = self.app.session_header
         resolution = header.get("resolution")
         unit = str(header.get("unit", ""))
