@@ -262,46 +262,99 @@ def format_diagnostics(
     return lines
 
 
-def format_channel(channel: ChannelAnalysis, config: AnalysisConfig, width: int = 80) -> list[str]:
-    """The report block of one channel."""
-    d, cap, chart = channel.descriptive, channel.capability, channel.chart
+def channel_figures(
+    channel: ChannelAnalysis, config: AnalysisConfig
+) -> tuple[tuple[str, str], ...]:
+    """A channel's figures as the text report labels them, label -> value: the extremes and
+    average, the limits and nominal, the count, sigma, range, skewness, mode and the pieces
+    beyond each limit. Every report format shows these same pairs."""
+    d, cap = channel.descriptive, channel.capability
     resolution = config.resolution
     limits = channel.limits
     n = d.n
-    unit = f" ({config.unit})" if config.unit else ""
-    lines = [f"FEATURE: {channel.name}{unit}   NO. PIECES: {n}", ""]
-    mode = " ".join(format_figure(m, resolution) for m in d.modes) or "-"
-    lines += _pairs(
-        [
-            ("MAXIMUM", format_figure(d.max, resolution)),
-            ("AVERAGE", format_figure(d.mean, resolution)),
-            ("MINIMUM", format_figure(d.min, resolution)),
-            ("UPPER SPEC", format_figure(None if limits is None else limits.usl, resolution)),
-            ("NOMINAL", format_figure(channel.nominal, resolution)),
-            ("LOWER SPEC", format_figure(None if limits is None else limits.lsl, resolution)),
-            ("TOTAL NUMBER OF PIECES", str(n)),
-            ("SIGMA", format_spread(d.sd, resolution)),
-            ("RANGE", format_spread(d.range, resolution)),
-        ],
-        width,
-    )
-    skew = "-" if d.skewness is None else f"{d.skewness:+.3f}"
-    lines += _wrap(f"SKEWNESS a1: {skew}   MODE: {mode}", width)
+    figures = [
+        ("MAXIMUM", format_figure(d.max, resolution)),
+        ("AVERAGE", format_figure(d.mean, resolution)),
+        ("MINIMUM", format_figure(d.min, resolution)),
+        ("UPPER SPEC", format_figure(None if limits is None else limits.usl, resolution)),
+        ("NOMINAL", format_figure(channel.nominal, resolution)),
+        ("LOWER SPEC", format_figure(None if limits is None else limits.lsl, resolution)),
+        ("TOTAL NUMBER OF PIECES", str(n)),
+        ("SIGMA", format_spread(d.sd, resolution)),
+        ("RANGE", format_spread(d.range, resolution)),
+        ("SKEWNESS a1", "-" if d.skewness is None else f"{d.skewness:+.3f}"),
+        ("MODE", " ".join(format_figure(m, resolution) for m in d.modes) or "-"),
+    ]
     for side, count in (("ABOVE UPPER", cap.above_usl), ("BELOW LOWER", cap.below_lsl)):
         percent = 100.0 * count / n if n else 0.0
-        lines.append(f"PIECES {side} SPEC: {count}   PERCENT {side} SPEC: {percent:.2f}")
+        figures += [(f"PIECES {side} SPEC", str(count)), (f"PERCENT {side} SPEC", f"{percent:.2f}")]
+    return tuple(figures)
+
+
+#: How many of :func:`channel_figures` the text report lays out in rows of three.
+_PAIRED_FIGURES = 9
+
+
+def format_figures(figures: Sequence[tuple[str, str]], width: int = 80) -> list[str]:
+    """:func:`channel_figures` as the text report lays them out: the first nine in rows of
+    three, then skewness and mode, then the pieces beyond each limit."""
+    said = dict(figures)
+    lines = _pairs(list(figures[:_PAIRED_FIGURES]), width)
+    lines += _wrap(f"SKEWNESS a1: {said['SKEWNESS a1']}   MODE: {said['MODE']}", width)
+    for side in ("ABOVE UPPER", "BELOW LOWER"):
+        lines.append(
+            f"PIECES {side} SPEC: {said[f'PIECES {side} SPEC']}   "
+            f"PERCENT {side} SPEC: {said[f'PERCENT {side} SPEC']}"
+        )
+    return lines
+
+
+def _out_of_spec_lines(channel: ChannelAnalysis, width: int) -> list[str]:
     found = channel.out_of_spec
-    if found is not None and found.total:
-        parts = []
-        if found.cycles_below:
-            parts.append(f"below LSL at cycles {number_list(found.cycles_below)}")
-        if found.cycles_above:
-            parts.append(f"above USL at cycles {number_list(found.cycles_above)}")
-        lines += _wrap(f"OUT OF SPEC: {found.total} readings, " + "; ".join(parts), width)
+    if found is None or not found.total:
+        return []
+    parts = []
+    if found.cycles_below:
+        parts.append(f"below LSL at cycles {number_list(found.cycles_below)}")
+    if found.cycles_above:
+        parts.append(f"above USL at cycles {number_list(found.cycles_above)}")
+    return _wrap(f"OUT OF SPEC: {found.total} readings, " + "; ".join(parts), width)
+
+
+def format_channel(
+    channel: ChannelAnalysis, config: AnalysisConfig, width: int = 80, *, readings: bool = True
+) -> list[str]:
+    """The report block of one channel; without its numbered readings when ``readings`` is
+    False (the filed report lists them in its own table)."""
+    d = channel.descriptive
+    resolution = config.resolution
+    unit = f" ({config.unit})" if config.unit else ""
+    lines = [f"FEATURE: {channel.name}{unit}   NO. PIECES: {d.n}", ""]
+    lines += format_figures(channel_figures(channel, config), width)
+    lines += _out_of_spec_lines(channel, width)
+    if readings:
+        lines.append("")
+        lines += format_readings(channel.readings, resolution, width, channel.cycles or None)
     lines.append("")
-    lines += format_readings(channel.readings, resolution, width, channel.cycles or None)
-    lines.append("")
-    lines.append(f"HISTOGRAM (bin width {format_spread(channel.histogram.bin_width, resolution)})")
+    lines += format_judgement(channel, config, width)
+    return lines
+
+
+def format_out_of_spec(channel: ChannelAnalysis, width: int = 80) -> list[str]:
+    """The cycles of a channel's readings beyond each limit (none when all are inside)."""
+    return _out_of_spec_lines(channel, width)
+
+
+def format_judgement(
+    channel: ChannelAnalysis, config: AnalysisConfig, width: int = 80
+) -> list[str]:
+    """What the text report says of a channel after its figures and readings: the histogram,
+    the control chart's limits and alarms (retrospective and live), the capability with its
+    intervals and verdict, and the diagnostics (normality, autocorrelation, drift)."""
+    cap, chart = channel.capability, channel.chart
+    resolution = config.resolution
+    limits = channel.limits
+    lines = [f"HISTOGRAM (bin width {format_spread(channel.histogram.bin_width, resolution)})"]
     lines += format_histogram(channel.histogram, limits, resolution, width, channel.nominal)
     lines.append("")
     dispersion = {"I-MR": "MR", "Xbar-R": "R", "Xbar-S": "S"}.get(chart.type, "dispersion")

@@ -2,15 +2,17 @@
 
 Each chart is one ``Figure`` drawn by ``FigureCanvasSVG``: the method's own charts (linearity's
 profiles along the bar, a gauge study's bias against the size: :meth:`Method.charts
-<station.methods.contract.Method.charts>`, drawn with this module's figure and colours), then the
-histogram of each judged channel against its limits, the control chart with its limits and the
-alarms marked, the 3-D offsets of x, y, z, and the readings over time with their trend (drift)
-where the method's readings are cycles in time order. Text is kept as SVG text (searchable,
-small). A channel name or a unit comes from outside and is shown as text: maths parsing is off
-while every chart is drawn (``$\\frac{1}{$`` would stop the report), its control characters
-are made visible (:func:`chart_text`) and a long one is cut with a mark (a 100,000-character
-name laid out by matplotlib took minutes), and matplotlib's warnings (a glyph the font lacks)
-stay off the terminal.
+<station.methods.contract.Method.charts>`, drawn with this module's figure and colours), then
+the histogram of each judged channel against its limits, the control chart with its limits and
+the alarms marked, the offsets of x, y, z seen along each axis pair, and the readings over time
+with their trend (drift) where the method's readings are cycles in time order. Text is kept as
+SVG text (searchable, small). A long session's series are drawn as their min/max envelope per
+column (:func:`envelope`) and its alarm circles one per column and value, so the SVG stays small
+whatever the count of cycles. A channel name or a unit comes from outside and is shown as text:
+maths parsing is off while every chart is drawn (``$\\frac{1}{$`` would stop the report), its
+control characters are made visible (:func:`chart_text`) and a long one is cut with a mark (a
+100,000-character name laid out by matplotlib took minutes), and matplotlib's warnings (a glyph
+the font lacks) stay off the terminal.
 """
 
 from __future__ import annotations
@@ -99,12 +101,63 @@ def _legend_outside(axes: Any) -> None:
     axes.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, fontsize=7)
 
 
+ENVELOPE_COLUMNS = 600
+"""Columns a long series is drawn in: about the pixel columns of a 7 in plot at 100 dpi. A
+series of more points than twice this is drawn as each column's least and greatest value."""
+SCATTER_POINTS = 2000
+"""The most distinct points a scatter draws as vector marks; more are drawn as one image."""
+
+
+def envelope(
+    x: np.ndarray, y: np.ndarray, columns: int = ENVELOPE_COLUMNS
+) -> tuple[np.ndarray, np.ndarray, bool]:
+    """A long series as its min/max envelope: ``x`` (ascending) cut into ``columns`` runs of
+    consecutive points, each drawn as its least and greatest ``y`` at the run's middle, so
+    every extreme stays in sight while the SVG holds ``2 * columns`` points whatever the
+    session's length. Returns the points to draw and whether they were reduced (a series of
+    at most ``2 * columns`` points is returned as it is)."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if y.size <= 2 * columns:
+        return x, y, False
+    starts = np.linspace(0, y.size, columns + 1).astype(int)
+    ends = starts[1:] - 1
+    starts = starts[:-1]
+    low, high = np.minimum.reduceat(y, starts), np.maximum.reduceat(y, starts)
+    middle = (x[starts] + x[ends]) / 2
+    return np.repeat(middle, 2), np.column_stack([low, high]).ravel(), True
+
+
+def envelope_column(x: np.ndarray, at: np.ndarray, columns: int = ENVELOPE_COLUMNS) -> np.ndarray:
+    """The column of :func:`envelope` each of the values ``at`` (on ``x``'s scale) falls in."""
+    x = np.asarray(x, dtype=float)
+    span = float(x[-1] - x[0]) or 1.0
+    return np.minimum(np.floor((np.asarray(at) - x[0]) / span * columns), columns - 1)
+
+
+def one_per_column(
+    x: np.ndarray, y: np.ndarray, marked: list[int], columns: int = ENVELOPE_COLUMNS
+) -> list[int]:
+    """Of the points ``marked`` (indices) of a series drawn as its :func:`envelope`, one for
+    each column and value: the others would be drawn on top of it, so every marked point still
+    lies under a mark while a long session's thousands of alarms stay a bounded SVG."""
+    index = np.asarray(marked, dtype=int)
+    places = np.column_stack([envelope_column(x, x[index], columns), np.asarray(y)[index]])
+    _, first = np.unique(places, axis=0, return_index=True)
+    return sorted(int(i) for i in index[first])
+
+
 def bin_id(key: str, centre: str, count: int) -> str:
     """The SVG id of a histogram bar (``histogram-x:+0.00010:4``): the channel (its key with
     anything but letters, digits, ``_`` and ``-`` made ``_``, cut to
     :data:`CHART_TEXT_LIMIT`: a name from outside is no markup), the gauge value the bar is
     centred on and its count, so the drawn counts can be checked against the text report's."""
     return f"histogram-{_SAFE_KEY.sub('_', key)[:CHART_TEXT_LIMIT]}:{centre}:{count}"
+
+
+def alarms_id(key: str) -> str:
+    """The SVG id of a control chart's alarm circles (``alarms-x``), one mark per circled
+    point, so the drawn alarms can be counted in the page."""
+    return f"alarms-{_SAFE_KEY.sub('_', key)[:CHART_TEXT_LIMIT]}"
 
 
 def histogram_chart(
@@ -173,11 +226,17 @@ def judged_limits(channel: Any) -> tuple[Any, tuple[Any, ...], str]:
 
 
 def control_chart(
-    name: str, channel: Any, xlabel: str = "cycle", resolution: float | None = None
+    name: str,
+    channel: Any,
+    xlabel: str = "cycle",
+    resolution: float | None = None,
+    key: str = "",
 ) -> Any:
     """The location chart: points by cycle (or stroke), the centre line and control limits its
     alarms were judged against (:func:`judged_limits`, named in the title and the legend),
-    those alarms circled in red."""
+    those alarms circled in red (their SVG group's id is :func:`alarms_id` of ``key``). More
+    than ``2 * ENVELOPE_COLUMNS`` points are drawn as their :func:`envelope`; the alarms'
+    circles are always drawn, each on its own point."""
     chart = channel.chart
     name = chart_text(name)
     lines, alarms, judged = judged_limits(channel)
@@ -186,8 +245,21 @@ def control_chart(
     points = np.asarray(chart.points, dtype=float)
     subgroup = max(1, chart.subgroup)
     labels = channel.cycles or tuple(range(1, len(channel.readings) + 1))
-    x = np.asarray([labels[min(i * subgroup, len(labels) - 1)] for i in range(points.size)])
-    axes.plot(x, points, marker="o", markersize=3, color=POINT_COLOUR, linewidth=1)
+    x = np.asarray(
+        [labels[min(i * subgroup, len(labels) - 1)] for i in range(points.size)], dtype=float
+    )
+    drawn_x, drawn_y, reduced = envelope(x, points)
+    if reduced:
+        # Each column's least and greatest point: every extreme in sight, the SVG small.
+        axes.plot(
+            drawn_x,
+            drawn_y,
+            color=POINT_COLOUR,
+            linewidth=0.6,
+            label=f"{points.size} points, min and max per column",
+        )
+    else:
+        axes.plot(x, points, marker="o", markersize=3, color=POINT_COLOUR, linewidth=1)
     for value, label, style in (
         (lines.center, "CL", "-"),
         (lines.ucl, "UCL", "--"),
@@ -199,6 +271,8 @@ def control_chart(
             axes.axhline(value, color=colour, linestyle=style, linewidth=1, label=shown)
     # Alarm points are 1-based positions on the chart.
     flagged = sorted({p - 1 for alarm in alarms for p in alarm.points if 1 <= p <= points.size})
+    if flagged and reduced:
+        flagged = one_per_column(x, points, flagged)
     if flagged:
         axes.scatter(
             x[flagged],
@@ -209,6 +283,7 @@ def control_chart(
             linewidths=1.5,
             label=f"alarm ({len(alarms)})",
             zorder=3,
+            gid=alarms_id(key),
         )
     axes.set_title(f"Control chart ({chart.type}) of {name}: {judged}", fontsize=8)
     axes.set_xlabel(xlabel)
@@ -217,27 +292,70 @@ def control_chart(
     return figure
 
 
-def offsets_chart(analysis: Any, unit: str) -> Any:
-    """The x, y, z readings in 3-D with the nominal and the mean (the offset) marked."""
+AXIS_PAIRS = (("x", "y"), ("x", "z"), ("y", "z"))
+SIZE_CLASSES = 4
+"""How many sizes the offsets chart draws a place's count in."""
+
+
+def offsets_chart(analysis: Any, unit: str, resolution: float | None = None) -> Any:
+    """The x, y, z readings seen along each axis pair (x–y, x–z, y–z: three small plots side by
+    side, each axis labelled in the one number format with a few ticks), the nominal and the
+    mean (the offset) marked and joined. Readings at the same place are drawn once, sized by
+    their count; more than :data:`SCATTER_POINTS` distinct places are drawn as one image."""
+    from matplotlib.ticker import MaxNLocator
+
     spatial = analysis.spatial
     channels = analysis.channels
-    names = [n for n in channels if n.lower() in ("x", "y", "z")]
-    arrays = [np.asarray(channels[n].readings, dtype=float) for n in names]
+    names = {n.lower(): n for n in channels if n.lower() in ("x", "y", "z")}
     unit = chart_text(unit)
-    figure = _figure(5.5, 4.5)
-    axes = figure.add_subplot(projection="3d")
-    axes.scatter(*arrays, s=8, color=POINT_COLOUR, alpha=0.6, label="readings")
-    nominal = [spatial.nominal[a] for a in ("x", "y", "z")]
-    mean = [nominal[i] + spatial.offset[a] for i, a in enumerate(("x", "y", "z"))]
-    axes.scatter(*[[v] for v in nominal], s=50, color="grey", marker="+", label="nominal")
-    axes.scatter(*[[v] for v in mean], s=50, color=ALARM_COLOUR, marker="x", label="mean")
-    axes.plot(*[[n, m] for n, m in zip(nominal, mean, strict=True)], color=ALARM_COLOUR)
     suffix = f" ({unit})" if unit else ""
-    axes.set_xlabel("x" + suffix)
-    axes.set_ylabel("y" + suffix)
-    axes.set_zlabel("z" + suffix)
-    axes.set_title("3-D offsets from nominal")
-    _legend_outside(axes)
+    figure = _figure(8.0, 3.0)
+    panels = figure.subplots(1, len(AXIS_PAIRS))
+    for axes, (first, second) in zip(panels, AXIS_PAIRS, strict=True):
+        pairs = np.column_stack(
+            [
+                np.asarray(channels[names[first]].readings, dtype=float),
+                np.asarray(channels[names[second]].readings, dtype=float),
+            ]
+        )
+        places, counts = np.unique(pairs, axis=0, return_counts=True)
+        # Four sizes, one mark each in the SVG (a size per point wrote a path per point).
+        classes = np.ceil(SIZE_CLASSES * counts / counts.max()).astype(int)
+        for size in range(1, SIZE_CLASSES + 1):
+            chosen = classes == size
+            if chosen.any():
+                axes.scatter(
+                    places[chosen, 0],
+                    places[chosen, 1],
+                    s=4 + 10 * size,
+                    color=POINT_COLOUR,
+                    alpha=0.6,
+                    rasterized=len(places) > SCATTER_POINTS,
+                    zorder=2,
+                )
+        nominal = (spatial.nominal[first], spatial.nominal[second])
+        mean = (nominal[0] + spatial.offset[first], nominal[1] + spatial.offset[second])
+        axes.scatter(*nominal, s=60, color="grey", marker="+", zorder=3)
+        axes.scatter(*mean, s=50, color=ALARM_COLOUR, marker="x", zorder=3)
+        axes.plot(*zip(nominal, mean, strict=True), color=ALARM_COLOUR, linewidth=1)
+        axes.set_xlabel(first + suffix)
+        axes.set_ylabel(second + suffix)
+        axes.set_title(f"{first}–{second}", fontsize=8)
+        for axis in (axes.xaxis, axes.yaxis):
+            axis.set_major_locator(MaxNLocator(nbins=4))
+            _figure_ticks(axis, resolution)
+        axes.tick_params(axis="both", labelsize=6)
+        axes.tick_params(axis="x", labelrotation=45)
+    legend = panels[0].collections
+    handles = [legend[0], legend[-2], legend[-1]]
+    figure.legend(
+        handles,
+        ["readings (size: count)", "nominal", "mean (offset)"],
+        loc="outside lower center",
+        ncols=3,
+        fontsize=7,
+    )
+    figure.suptitle("Offsets from nominal, seen along each axis pair", fontsize=9)
     return figure
 
 
@@ -274,12 +392,20 @@ def drift_chart(
     for channel, (seconds, values) in series.items():
         elapsed = seconds / scale
         channel = chart_text(channel)
-        (line,) = axes.plot(elapsed, values, marker=".", linewidth=0.8, label=channel)
+        drawn_x, drawn_y, reduced = envelope(elapsed, values)
+        (line,) = axes.plot(
+            drawn_x,
+            drawn_y,
+            marker=None if reduced else ".",
+            linewidth=0.6 if reduced else 0.8,
+            label=f"{channel} (min and max per column)" if reduced else channel,
+        )
         if np.ptp(elapsed) > 0:
             slope, intercept = np.polyfit(elapsed, values, 1)
+            ends = np.asarray([elapsed.min(), elapsed.max()])  # a straight line: two points
             axes.plot(
-                elapsed,
-                intercept + slope * elapsed,
+                ends,
+                intercept + slope * ends,
                 color=line.get_color(),
                 linestyle="--",
                 label=f"{channel} trend {format_figure(slope, resolution, unit=unit)}/{label}",
@@ -344,10 +470,10 @@ def _figures(analysed: AnalysedSession) -> Iterator[tuple[str, str, Any]]:
             yield (
                 f"control-{key}",
                 f"Control chart of {chart_text(channel.name)}",
-                control_chart(channel.name, channel, resolution=resolution),
+                control_chart(channel.name, channel, resolution=resolution, key=str(key)),
             )
     if analysis.spatial is not None:
-        yield "offsets-3d", "3-D offsets", offsets_chart(analysis, unit)
+        yield "offsets-3d", "3-D offsets", offsets_chart(analysis, unit, resolution)
     if report.method.drift_chart:
         drift = drift_chart(analysed, unit, resolution)
         if drift is not None:

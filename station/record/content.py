@@ -3,9 +3,11 @@ html by :mod:`station.record.render`.
 
 Everything is formatted here, once, so the three formats cannot disagree: the robot, operator,
 procedure (id, version, sha256), date and duration, gauges, zeroes, limits, every reading with
-the rejects and their reasons, notes, alarms with their acknowledgements, the verdicts with the
-lower confidence bound of Cpk, hints, the procedure's own blocks, the anchor (the last line's
-hash) and the signature id, and the sign-off lines. Text from outside stays raw here; each
+the rejects and their reasons, notes, alarms with their acknowledgements, the overall verdict
+(the session's word and each channel's, with Cpk and its one-sided Bissell bounds), every judged
+channel's statistics as the text report (``station analyze``) gives them, hints, the
+procedure's own blocks, the anchor (the last line's hash) and the signature id, and the sign-off
+lines. Text from outside stays raw here; each
 format escapes it (see :mod:`station.record.text`).
 """
 
@@ -16,15 +18,24 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
 
+from station.analysis.report import (
+    channel_figures,
+    format_figures,
+    format_judgement,
+    format_out_of_spec,
+)
 from station.analysis.rules import rule_name
+from station.analysis.verdict import confidence_text
 from station.record.source import AnalysedSession
 from station.text import (
     NOT_AVAILABLE,
     format_figure,
     format_index,
     format_spread,
+    judged_count,
     judged_cpk,
     judged_label,
+    overall_judgement,
 )
 
 MISSING = NOT_AVAILABLE
@@ -104,7 +115,8 @@ class AlarmLine:
 
 @dataclass(frozen=True)
 class Verdict:
-    """One judged channel: n, mean, σ, Cp, Cpk with its lower confidence bound, the word."""
+    """One judged channel: n, mean, σ, Cp, Cpk with its one-sided confidence bounds (Bissell),
+    the word, and the decision in a sentence (why the word, and the report's own rule)."""
 
     channel: str
     name: str
@@ -114,10 +126,30 @@ class Verdict:
     cp: str
     cpk: str
     cpk_lower: str
+    cpk_upper: str
     confidence: str
-    """The one-sided confidence level of ``cpk_lower`` (``95%``)."""
+    """The one-sided confidence level of ``cpk_lower`` and ``cpk_upper`` (``95%``)."""
     word: str
     message: str
+    decision: str = ""
+    """The verdict line without ``VERDICT:`` (``CAPABLE (Cpk 1.80; Bissell 95% lower bound
+    1.39 >= 1; by the report's rule: capable, Cpk 1.80 >= 1)``)."""
+
+
+@dataclass(frozen=True)
+class ChannelStatistics:
+    """Everything the text report (``station analyze``) says of one judged channel but its
+    numbered readings, which the filed report lists in its own table: the labelled figures
+    (maximum ... skewness, mode, pieces beyond each limit) and the lines that follow them
+    (out-of-spec cycles, histogram, control chart and alarms, capability with its intervals,
+    normality, autocorrelation, drift)."""
+
+    channel: str
+    heading: str
+    figures: tuple[tuple[str, str], ...]
+    figure_lines: tuple[str, ...]
+    """``figures`` laid out as the text report lays them out (the txt format prints these)."""
+    lines: tuple[str, ...]
 
 
 @dataclass(frozen=True)
@@ -154,6 +186,13 @@ class ReportContent:
     notes: tuple[NoteLine, ...]
     alarms: tuple[AlarmLine, ...]
     verdicts: tuple[Verdict, ...]
+    overall: str
+    """The session's verdict word (``CAPABLE``, ``PROVISIONAL: 9 of 25``, a method's own word),
+    MISSING when nothing was judged."""
+    overall_basis: str
+    """What the overall word rests on: the count judged and the decision rule, or the method's
+    own sentence."""
+    statistics: tuple[ChannelStatistics, ...]
     figures: tuple[tuple[str, str], ...]
     """Label → value of the 3-D figures (offsets, RP, AP), empty without x, y, z."""
     sections: tuple[tuple[str, ...], ...]
@@ -401,12 +440,58 @@ def _verdicts(analysed: AnalysedSession, resolution: float | None) -> tuple[Verd
                 cp=format_index(cap.cp),
                 cpk=judged_cpk(channel),
                 cpk_lower=format_index(cap.cpk_lower),
-                confidence=f"{cap.confidence:.0%}",
+                cpk_upper=format_index(cap.cpk_upper),
+                confidence=confidence_text(cap.confidence),
                 word=judged_label(channel),
                 message=str(cap.message or ""),
+                decision=channel.verdict.text if channel.verdict is not None else "",
             )
         )
     return tuple(verdicts)
+
+
+def _overall(analysed: AnalysedSession) -> tuple[str, str]:
+    """The session's word and what it rests on (see ``ReportContent.overall``): the channels'
+    judgement (:func:`~station.text.overall_judgement`, the summary's and history's too), else a
+    method's own verdict, else MISSING with why."""
+    report = analysed.report
+    if report is None:
+        return MISSING, f"no verdict: {analysed.problem or 'nothing to judge'}"
+    analysis = report.analysis
+    if analysis is not None and analysis.channels:
+        config = analysis.config
+        level = confidence_text(config.confidence)
+        count = judged_count(analysis)
+        # The rule in lower case: the words in capitals are verdicts, and this is none.
+        basis = (
+            f"{count[:1].upper()}{count[1:]}; capable when Cpk's one-sided {level} lower bound "
+            f"(Bissell) reaches {config.threshold:g}, not capable when its upper bound is below "
+            f"{config.threshold:g}, inconclusive between; the session is capable only when "
+            "every channel is, not capable when any is"
+        )
+        return overall_judgement(analysis.channels.values()), basis
+    if report.verdict is not None:
+        return str(report.verdict.word), str(report.verdict.sentence)
+    return MISSING, "this procedure judges no readings by capability: its results are below"
+
+
+def _statistics(analysed: AnalysedSession) -> tuple[ChannelStatistics, ...]:
+    """Each judged channel's block of the text report, without the numbered readings."""
+    if analysed.report is None or analysed.report.analysis is None:
+        return ()
+    analysis = analysed.report.analysis
+    config = analysis.config
+    unit = f" ({config.unit})" if config.unit else ""
+    return tuple(
+        ChannelStatistics(
+            channel=str(channel.name),
+            heading=f"{channel.name}{unit}, {channel.descriptive.n} pieces",
+            figures=channel_figures(channel, config),
+            figure_lines=tuple(format_figures(channel_figures(channel, config))),
+            lines=(*format_out_of_spec(channel), *format_judgement(channel, config)),
+        )
+        for channel in analysis.channels.values()
+    )
 
 
 def _figures(analysed: AnalysedSession, resolution: float | None) -> tuple[tuple[str, str], ...]:
@@ -421,6 +506,10 @@ def _figures(analysed: AnalysedSession, resolution: float | None) -> tuple[tuple
     ]
     figures.append(("Total offset (APp)", format_spread(spatial.total_offset, resolution)))
     figures.append(("Pose repeatability RP = l̄ + 3·S_l", format_spread(spatial.rp, resolution)))
+    figures.append(
+        ("l̄ (mean distance from the mean pose)", format_spread(spatial.l_mean, resolution))
+    )
+    figures.append(("S_l (its standard deviation)", format_spread(spatial.l_sd, resolution)))
     return tuple(figures)
 
 
@@ -435,6 +524,7 @@ def build_content(analysed: AnalysedSession) -> ReportContent:
     procedure = header.get("procedure") or {}
     acks = _acknowledgements(session)
     report = analysed.report
+    overall, overall_basis = _overall(analysed)
     streamed = ""
     if session.samples:
         points = sum(len(batch.values) for batch in session.samples)
@@ -495,6 +585,9 @@ def build_content(analysed: AnalysedSession) -> ReportContent:
         ),
         alarms=alarms,
         verdicts=_verdicts(analysed, resolution),
+        overall=overall,
+        overall_basis=overall_basis,
+        statistics=_statistics(analysed),
         figures=_figures(analysed, resolution),
         sections=report.sections if report is not None else (),
         hints=tuple(report.analysis.hints) if report is not None and report.analysis else (),

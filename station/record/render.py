@@ -9,6 +9,7 @@ inline SVG, no script and a Content-Security-Policy that allows nothing from out
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
 from functools import cache
 from pathlib import Path
@@ -24,6 +25,8 @@ from station.record.source import AnalysedSession, analyse_session
 from station.record.text import markdown_text, plain
 
 FORMATS = ("txt", "md", "html")
+WIDTH = 80
+"""The text report's width (its rules and wrapped sentences)."""
 
 
 class _Trusted(str):
@@ -53,6 +56,18 @@ def _environment(fmt: str) -> Any:
         lstrip_blocks=True,
     )
     environment.filters["ljust"] = lambda value, width: plain(value).ljust(int(width))
+    # A long sentence (the verdict's basis) folded at the text report's width, each piece plain.
+    environment.filters["wrap"] = lambda value, indent="": Markup(
+        "\n".join(
+            textwrap.wrap(
+                plain(value),
+                WIDTH,
+                initial_indent=indent,
+                subsequent_indent=indent + "  ",
+                break_on_hyphens=False,
+            )
+        )
+    )
     if fmt == "md":
         # Inside a Markdown code block or span nothing is markup: plain text without backticks.
         environment.filters["code"] = lambda value: Markup(plain(value).replace("`", "'"))

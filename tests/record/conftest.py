@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from station.analysis.capability import SpecLimits
 from station.instruments.simulator import FixtureModel
 from station.instruments.zeroing import zero_from_readings
 from station.procedures import discover_procedures
@@ -225,6 +226,68 @@ def write_linearity(
                     end=True if start + 20 >= points else None,
                 )
         writer.append("note", text="bar cleaned before stroke 1")
+        writer.append("finish", by="operator", complete=True)
+    return writer.path
+
+
+def write_gauge_check(
+    folder: Path, *, robot: str = "bench", seed: int = 4, cycles: int = 30, bias: float = 0.00005
+) -> Path:
+    """A finished gauge check (Type-1 study) of one indicator on a 0.25 in gauge block: the
+    gauge id, reference and tolerance typed, the zero on the plate, ``cycles`` readings."""
+    rng = np.random.default_rng(seed)
+    header = header_fields("gauge_check", robot=robot)
+    with SessionWriter.create(folder, header, now=WHEN) as writer:
+        writer.append("step", step="stand", action="confirmed", by="operator")
+        writer.append(
+            "input",
+            step="reference",
+            values={"gauge": "DI-7", "reference": 0.25, "tolerance": 0.002},
+        )
+        writer.append(
+            "zero", step="zero-plate", channels={"x": {"method": "software", "offset": 0.1}}
+        )
+        for cycle in range(1, cycles + 1):
+            value = round(round((0.25 + bias + rng.normal(0, 0.00006)) / 0.0001) * 0.0001, 6)
+            writer.append(
+                "reading",
+                cycle=cycle,
+                step="readings",
+                channels=_reading({"x": value}, "in", 0.1),
+            )
+        writer.append("finish", by="operator", complete=True)
+    return writer.path
+
+
+def write_joints(
+    folder: Path, *, robot: str = "KSC-7", seed: int = 5, joints: int = 3, per: int = 10
+) -> Path:
+    """A finished per-joint troubleshooting session: ``per`` returns of each of ``joints``
+    joints, its lever arm typed, joint 2 twice as loose as the others."""
+    rng = np.random.default_rng(seed)
+    limits = {a: SpecLimits(lsl=-0.001, usl=0.001) for a in AXES}
+    header = header_fields("joint_troubleshooting", robot=robot, placements=joints, limits=limits)
+    cycle = 0
+    with SessionWriter.create(folder, header, now=WHEN) as writer:
+        for joint in range(1, joints + 1):
+            writer.append("input", step="lever", placement=joint, values={"lever": 10.0 * joint})
+            writer.append(
+                "zero",
+                step="zero",
+                placement=joint,
+                channels={a: {"method": "software", "offset": 0.25} for a in AXES},
+            )
+            spread = 0.0004 if joint == 2 else 0.0002
+            for _ in range(per):
+                cycle += 1
+                values = {a: round(float(rng.normal(0, spread)), 4) for a in AXES}
+                writer.append(
+                    "reading",
+                    cycle=cycle,
+                    step="returns",
+                    placement=joint,
+                    channels=_reading(values, "in", 0.25),
+                )
         writer.append("finish", by="operator", complete=True)
     return writer.path
 

@@ -5,20 +5,30 @@ ones, circled the point after each alarm, and its legend covered the last point.
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 from helpers import run_station
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-from station.record.charts import control_chart, histogram_chart
+from station.record.charts import (
+    alarms_id,
+    control_chart,
+    envelope,
+    envelope_column,
+    histogram_chart,
+    judged_limits,
+)
 from station.record.render import render_report
 from station.record.source import analyse_session
 from station.session.journal import SessionWriter
 from station.text import format_figure
 
 from .conftest import WHEN, _reading, header_fields, write_repeatability
+from .test_report import CHROMIUM, chromium, console_messages
 
 RESOLUTION = 0.0001
 QUIET = [0.0, 0.0001, -0.0001, 0.0, 0.0001, 0.0, -0.0001, 0.0001, 0.0, -0.0001]
@@ -124,3 +134,66 @@ def test_the_legend_stands_outside_the_data(sessions, chart):
     legend = axes.get_legend().get_window_extent()
     assert legend.x0 >= axes.get_window_extent().x1, (legend, axes.get_window_extent())
     assert legend.x1 <= figure.bbox.x1 + 1  # and on the page
+
+
+def test_the_envelope_keeps_every_extreme_in_a_bounded_number_of_points():
+    rng = np.random.default_rng(7)
+    y = rng.normal(0, 1, 50_000)
+    y[12_345], y[40_000] = 9.0, -9.0
+    x = np.arange(1, y.size + 1, dtype=float)
+    drawn_x, drawn_y, reduced = envelope(x, y, columns=500)
+    assert reduced and drawn_y.size == 1000
+    assert drawn_y.max() == 9.0 and drawn_y.min() == -9.0
+    assert np.all(np.diff(drawn_x) >= 0)  # still in cycle order
+    short = np.arange(10.0)
+    assert envelope(short, short)[2] is False
+
+
+def _svg_bytes(html: str) -> list[int]:
+    return [len(svg) for svg in re.findall(r"<svg.*?</svg>", html, re.S)]
+
+
+def test_a_long_session_draws_small_charts_that_still_mark_every_alarm(tmp_path, monkeypatch):
+    """A 20,000-cycle session drew 18.6 MB of SVG (every point a marker, every alarm a
+    circle, a 3-D scatter of every reading) and took minutes. Its charts now weigh under
+    1 MB together (each column of a long series its least and greatest point), and every
+    alarmed point still lies under a circle of its chart."""
+    # Writing speed, not durability, is what 20,000 fsyncs would cost here.
+    monkeypatch.setattr(os, "fsync", lambda fd: None)
+    path = write_repeatability(tmp_path, cycles=20_000, alarm=False)
+    monkeypatch.undo()
+    html = render_report(path, "html")
+    sizes = _svg_bytes(html)
+    assert len(sizes) == 8 and sum(sizes) < 1_000_000, sizes
+    # The rest of the page is the record itself: the readings table lists every cycle.
+    assert len(html) < 6_000_000
+    channels = analyse_session(path).report.analysis.channels
+    for key, channel in channels.items():
+        _, alarms, _ = judged_limits(channel)
+        cycles = np.asarray(channel.cycles, dtype=float)
+        alarmed = sorted({p - 1 for alarm in alarms for p in alarm.points})
+        assert alarmed, f"{key}: a 20,000-cycle session of this noise raises alarms"
+        figure = control_chart(key, channel, resolution=RESOLUTION, key=key)
+        (circles,) = [c for c in figure.axes[0].collections if c.get_gid() == alarms_id(key)]
+        circled = {
+            (column, value)
+            for column, (_, value) in zip(
+                envelope_column(cycles, circles.get_offsets()[:, 0]),
+                circles.get_offsets(),
+                strict=True,
+            )
+        }
+        points = np.asarray(channel.chart.points)
+        under = {
+            (column, points[i])
+            for column, i in zip(envelope_column(cycles, cycles[alarmed]), alarmed, strict=True)
+        }
+        assert under == circled, key
+        group = re.search(rf'<g id="{alarms_id(key)}">(.*?)\n   </g>', html, re.S)
+        assert group is not None and group.group(1).count("<use") == len(circled), key
+    if CHROMIUM is not None:
+        page = tmp_path / "long.html"
+        page.write_text(html, encoding="utf-8")
+        result = chromium(page.as_uri(), "--dump-dom")
+        assert console_messages(result.stderr) == []
+        assert result.stdout.count('class="chart"') == 8

@@ -19,13 +19,25 @@ from station.record.content import MISSING, acknowledgement_of, build_content
 from station.record.render import render_report
 from station.record.source import analyse_session
 
-from .conftest import write_accuracy, write_linearity, write_repeatability
+from .conftest import (
+    write_accuracy,
+    write_gauge_check,
+    write_joints,
+    write_linearity,
+    write_repeatability,
+)
 
 CHROMIUM = shutil.which("chromium-headless-shell")
 BUILDERS = {
     "repeatability": write_repeatability,
     "relative_accuracy": write_accuracy,
     "linearity": write_linearity,
+}
+# A session of each procedure with a capability analysis (the verdict the overall block states).
+CAPABILITY_BUILDERS = {
+    **BUILDERS,
+    "gauge_check": write_gauge_check,
+    "joint_troubleshooting": write_joints,
 }
 # Charts each demo session draws: histogram + control chart per judged channel, then the 3-D
 # offsets and drift (x, y, z sessions) or one profile chart per indicator (linearity).
@@ -152,9 +164,14 @@ def facts(content) -> list[str]:
         content.duration,
         f"{len(content.readings)} cycles, {len(content.rejected)} rejected",
     ]
+    said += [content.overall, content.overall_basis]
     for verdict in content.verdicts:
         said += [verdict.name, verdict.word, verdict.mean, verdict.sd, verdict.cpk]
-        said += [verdict.cpk_lower, verdict.confidence]
+        said += [verdict.cpk_lower, verdict.cpk_upper, verdict.confidence, verdict.decision]
+    for block in content.statistics:
+        said.append(block.heading)
+        said += [f"{label} {value}" for label, value in block.figures]
+        said += [line.strip() for line in block.lines if line.strip()]
     for row in content.readings:
         said += [*row.values, row.status]
     said += [f"Rejected cycle {cycle}: {reason}" for cycle, reason in content.rejected]
@@ -169,20 +186,37 @@ def facts(content) -> list[str]:
     return said
 
 
-@pytest.mark.parametrize("kind", list(BUILDERS))
+def _same_words(text: str) -> str:
+    """Text with its whitespace collapsed and the text report's ``LABEL: value`` pairs read as
+    the tables' ``LABEL value`` cells."""
+    return " ".join(re.sub(r":(?=\s|$)", " ", text).split())
+
+
+@pytest.mark.parametrize("kind", list(CAPABILITY_BUILDERS))
 def test_txt_md_html_say_the_same(kind, sessions):
-    path = BUILDERS[kind](sessions)
+    """Every format carries the same facts, the overall verdict block (each channel's word,
+    Cpk and its Bissell bounds, the session's word) and the text report's full statistics."""
+    path = CAPABILITY_BUILDERS[kind](sessions)
     content = build_content(analyse_session(path))
     texts = {
-        "txt": " ".join(render_report(path, "txt").split()),
+        "txt": render_report(path, "txt"),
         "md": visible_text(markdown_html(render_report(path, "md"))),
         "html": visible_text(render_report(path, "html")),
     }
-    expected = [" ".join(fact.split()) for fact in facts(content)]
+    expected = [_same_words(fact) for fact in facts(content)]
     assert len(expected) > 40
+    assert content.verdicts and content.statistics
+    assert content.overall != MISSING
     for fmt, text in texts.items():
-        missing = [fact for fact in expected if fact not in text]
+        said = _same_words(text)
+        missing = [fact for fact in expected if fact not in said]
         assert missing == [], f"{fmt} lacks {missing[:5]}"
+        # The verdict at the top, the statistics with skewness and normality in each format.
+        said = said.lower()
+        top = said.index(_same_words(f"verdict {content.overall}".lower()))
+        readings = said.index(f"readings ({len(content.readings)} cycles")
+        assert top < readings and "bissell" in said[top:readings]
+        assert "skewness a1" in said and "normality" in said
     # The same number of rejected readings in each.
     assert len({text.count("rejected: ") for text in texts.values()}) == 1
 
@@ -305,12 +339,12 @@ def test_report_of_a_real_headless_capture(tmp_path):
     assert content.gauges[0].port == url and len(content.readings) == 25
     assert {zero.channel for zero in content.zeroes} == {"x", "y", "z"}
     texts = {
-        "txt": " ".join(render_report(path, "txt").split()),
-        "md": visible_text(markdown_html(render_report(path, "md"))),
-        "html": visible_text(render_report(path, "html")),
+        "txt": _same_words(render_report(path, "txt")),
+        "md": _same_words(visible_text(markdown_html(render_report(path, "md")))),
+        "html": _same_words(visible_text(render_report(path, "html"))),
     }
     for fmt, text in texts.items():
-        missing = [f for f in (" ".join(f.split()) for f in facts(content)) if f not in text]
+        missing = [f for f in (_same_words(f) for f in facts(content)) if f not in text]
         assert missing == [], f"{fmt} lacks {missing[:5]}"
 
 
