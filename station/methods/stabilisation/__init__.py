@@ -1,0 +1,1 @@
+"""Position stabilisation time and overshoot, ISO 9283 §7.4–7.5 (issue 21, item 2)."""
