@@ -7,11 +7,13 @@ robot comes to rest, here the mean of the trace's last ``tail`` seconds (the sti
 arrival trigger waited for). The *band* is a sphere of radius ``band`` about it. Along the
 trace, d_j = ‖p_j − p_final‖:
 
-* the **stabilisation time** runs from the first point inside the band to the first point of
-  the stretch that stays inside it to the end of the trace (0 when the robot never leaves the
-  band again after entering it). A trace whose last point lies outside the band never settled:
-  it has no time, and says so; one whose first point is already inside the band did not show
-  its entry, and has no time either;
+* the **stabilisation time** runs from the first entry into the band to the last one, after
+  which the trace stays inside to its end (0 when the robot never leaves the band again after
+  entering it). Between two points the trace is taken as a straight line, and an entry is
+  where that line crosses into the band: a robot that swings through its final position
+  between two points has entered it, though neither point lies inside. A trace whose last
+  point lies outside the band never settled: it has no time, and says so; one whose first
+  point is already inside the band did not show its entry, and has no time either;
 * the **overshoot** is the largest d_j from the first entry on (a distance, ISO's figure), and
   per axis the largest excursion past the final position, on the far side from where the axis
   came (0 when it never went past).
@@ -73,6 +75,10 @@ class ReturnSettling:
     points: int
     final: tuple[float, ...]
     problem: str = ""
+    time_max: float | None = None
+    """When the trace moved more than the band between two points before its entry and passed
+    near enough to have crossed it unseen: the time had the robot entered then (the time is
+    then known only to lie between ``time`` and this); None otherwise."""
 
     @property
     def settled(self) -> bool:
@@ -174,24 +180,36 @@ def return_settling(
         overshoot: float | None,
         axes: tuple[float, ...] | None,
         problem: str = "",
+        time_max: float | None = None,
     ) -> ReturnSettling:
         return ReturnSettling(
-            cycle, time, overshoot, axes, interval, int(times.size), final_tuple, problem
+            cycle, time, overshoot, axes, interval, int(times.size), final_tuple, problem, time_max
         )
 
-    if not inside.any():
-        return made(None, None, None, "it never came within the band")
-    entry = int(np.argmax(inside))
-    after = slice(entry, None)
-    # Past the final position: on the far side from where each axis came (its first point).
-    side = np.sign(rest - rows[0])
-    past = (rows[after] - rest) * side
-    axes = tuple(float(max(0.0, v)) for v in past.max(axis=0))
-    overshoot = float(distance[after].max())
-    if entry == 0:
+    relative = rows - rest
+    if inside[0]:
+        # Its approach is not in the trace: when it came in is unknown.
+        side0 = np.zeros(rows.shape[1])
         return made(
-            None, overshoot, axes, "its trace starts inside the band, so its entry was not seen"
+            None,
+            float(distance.max()),
+            _past(relative, side0),
+            "its trace starts inside the band, so its entry was not seen",
         )
+    entered = None
+    for j in range(times.size - 1):
+        s = _crossing_in(relative[j], relative[j + 1], band)
+        if s is not None:
+            entered = (j, float(times[j] + s * (times[j + 1] - times[j])))
+            break
+    if entered is None:
+        return made(None, None, None, "it never came within the band")
+    j, t_entry = entered
+    # What comes after the entry: the points from the end of the segment it entered on.
+    after = slice(j + 1, None)
+    # Past the final position: on the far side from where each axis came (its first point).
+    axes = _past(relative[after], np.sign(-relative[0]))
+    overshoot = float(distance[after].max())
     if not inside[-1]:
         return made(
             None,
@@ -200,8 +218,64 @@ def return_settling(
             "it was outside the band at the end of its trace: it never settled",
         )
     outside = np.flatnonzero(~inside[after])
-    stays = entry if outside.size == 0 else entry + int(outside[-1]) + 1
-    return made(float(times[stays] - times[entry]), overshoot, axes)
+    unseen = _unseen_entry(relative[: j + 1], band)
+    if outside.size == 0:
+        t_stay = t_entry
+    else:
+        last = j + 1 + int(outside[-1])
+        back = _crossing_in(relative[last], relative[last + 1], band)
+        assert back is not None  # from a point outside to one inside: it crosses
+        t_stay = float(times[last] + back * (times[last + 1] - times[last]))
+    longest = None if unseen is None else t_stay - float(times[unseen])
+    return made(t_stay - t_entry, overshoot, axes, time_max=longest)
+
+
+def _unseen_entry(relative: np.ndarray, band: float) -> int | None:
+    """The first point of the earliest stretch before the entry's (``relative``: the points up
+    to the start of the segment the entry was found on) where the robot moved more than the
+    band between two points and came within the band plus half that move of the final
+    position: a path that bends between the points may have entered there, unseen. The stretch
+    just before the entry's is left out: an entry there is within a sampling interval."""
+    for k in range(relative.shape[0] - 2):
+        a, b = relative[k], relative[k + 1]
+        step = float(np.linalg.norm(b - a))
+        if step > band and _closest(a, b) <= band + step / 2:
+            return k
+    return None
+
+
+def _closest(a: np.ndarray, b: np.ndarray) -> float:
+    """The distance of the straight line from ``a`` to ``b`` from the origin (the final
+    position)."""
+    v = b - a
+    square = float(v @ v)
+    s = 0.0 if square == 0.0 else min(1.0, max(0.0, -float(a @ v) / square))
+    return float(np.linalg.norm(a + s * v))
+
+
+def _past(relative: np.ndarray, side: np.ndarray) -> tuple[float, ...]:
+    """Per axis, the largest excursion of ``relative`` (points less the final position) on
+    the ``side`` (+1, −1; 0: none) past the final position; 0 when it never went past."""
+    return tuple(float(max(0.0, v)) for v in (relative * side).max(axis=0))
+
+
+def _crossing_in(a: np.ndarray, b: np.ndarray, radius: float) -> float | None:
+    """Where (0..1) the straight line from ``a`` to ``b`` (points less the final position)
+    first comes within ``radius``; None when it does not. Between two points the trace is
+    taken as straight: a robot passing through its final position between two points far
+    apart still entered the band."""
+    if float(a @ a) <= radius**2:
+        return 0.0
+    v = b - a
+    square = float(v @ v)
+    if square == 0.0:
+        return None
+    half = float(a @ v)
+    disc = half**2 - square * (float(a @ a) - radius**2)
+    if disc < 0:
+        return None
+    s = (-half - math.sqrt(disc)) / square
+    return s if 0.0 <= s <= 1.0 else None
 
 
 @dataclass(frozen=True)
@@ -251,6 +325,7 @@ class Stabilisation:
                     "sampling_interval": r.interval,
                     "points": r.points,
                     "settled": r.settled,
+                    "time_max": r.time_max,
                     "problem": r.problem or None,
                 }
                 for r in self.returns
@@ -355,6 +430,13 @@ def lines(result: Stabilisation) -> list[str]:
         time_text = f"{seconds(r.time)} ± {seconds(r.interval)}"
         past = " ".join(size(v) for v in r.overshoot_axes)
         out.append(f"  {r.cycle:>5}  {time_text:>14}  {size(r.overshoot):>10}  {past}")
+        if r.time_max is not None:
+            out.append(
+                f"         or up to {seconds(r.time_max)} s: before its entry the trace moved "
+                "more than the band between two points near the final position, and may have "
+                "crossed it unseen, and overshot more after it (read the indicators faster, "
+                "or widen the band)"
+            )
     n = len(result.returns)
     unsettled = result.unsettled
     if unsettled:
@@ -373,6 +455,12 @@ def lines(result: Stabilisation) -> list[str]:
             f"  stabilisation time: mean {seconds(result.mean_time)} s ({ci}), largest "
             f"{seconds(result.max_time)} s; each ± {seconds(step)} s (the sampling interval)"
         )
+        doubtful = [r.cycle for r in result.returns if r.time_max is not None]
+        if doubtful:
+            out.append(
+                f"  (cycles {', '.join(map(str, doubtful))} may have entered the band unseen, "
+                "earlier: their times, the mean and the largest may be longer, as said above)"
+            )
     if result.mean_overshoot is not None and result.max_overshoot is not None:
         interval = result.mean_overshoot_ci
         entered = sum(1 for r in result.returns if r.overshoot is not None)
