@@ -19,8 +19,9 @@ trace, d_j = ‖p_j − p_final‖:
   came (0 when it never went past).
 
 A trace is sampled: the entry lies between the last point outside and the first inside, and
-likewise the moment it stays, so a time is known to ± one sampling interval, and a peak between
-two points is not seen. Every figure here says its sampling interval.
+likewise the moment it stays, so each end of a time is known to one sampling interval and the
+time to ± two, and a peak between two points is not seen. Every figure here says its sampling
+interval.
 
 Pure functions over numpy arrays, results as frozen dataclasses; no I/O.
 """
@@ -415,8 +416,9 @@ def lines(result: Stabilisation) -> list[str]:
         "ISO 9283 POSITION STABILISATION TIME AND OVERSHOOT (§7.4, §7.5)",
         f"  band: {size(result.band.radius)} {unit} about the final position (the mean of "
         f"its still tail), {result.band.basis}",
-        f"  traces sampled every {seconds(step)} s: a time is known to ± {seconds(step)} s, and "
-        "a peak between two points is not seen",
+        f"  traces sampled every {seconds(step)} s: each end of a time is found within one "
+        f"sampling interval, so a time is known to ± {seconds(2 * step)} s, and a peak "
+        "between two points is not seen",
         f"  {'cycle':>5}  {'time (s)':>14}  {'overshoot':>10}  past " + " / ".join(result.axes),
     ]
     for r in result.returns:
@@ -427,7 +429,7 @@ def lines(result: Stabilisation) -> list[str]:
             out.append(f"  {r.cycle:>5}  {shown}")
             continue
         assert r.overshoot is not None and r.overshoot_axes is not None
-        time_text = f"{seconds(r.time)} ± {seconds(r.interval)}"
+        time_text = f"{seconds(r.time)} ± {seconds(2 * r.interval)}"
         past = " ".join(size(v) for v in r.overshoot_axes)
         out.append(f"  {r.cycle:>5}  {time_text:>14}  {size(r.overshoot):>10}  {past}")
         if r.time_max is not None:
@@ -453,7 +455,7 @@ def lines(result: Stabilisation) -> list[str]:
         )
         out.append(
             f"  stabilisation time: mean {seconds(result.mean_time)} s ({ci}), largest "
-            f"{seconds(result.max_time)} s; each ± {seconds(step)} s (the sampling interval)"
+            f"{seconds(result.max_time)} s; each ± {seconds(2 * step)} s (two sampling intervals)"
         )
         doubtful = [r.cycle for r in result.returns if r.time_max is not None]
         if doubtful:
