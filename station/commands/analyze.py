@@ -31,6 +31,7 @@ OPTION_FLAGS = {
     "process_variation": "--process-variation",
     "pool_above": "--pool-above",
     "distance": "--distance",
+    "band": "--band",
 }
 """The command line's values a method's analysis may take (its ``options``), by flag."""
 SUBGROUP_LIMIT = 1000
@@ -173,6 +174,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         metavar="PA:PB=D",
         help="pose_characteristics: the two poses AD and RD are measured between and their "
         "command distance D (without =D: from their command poses)",
+    )
+    parser.add_argument(
+        "--band",
+        metavar="R",
+        help="stabilisation: the band's radius about the final position, in the session's "
+        "unit (e.g. the manufacturer's stated limit; default 5 x the indicators' noise at rest)",
     )
     parser.add_argument("--json", action="store_true", help="print one JSON document")
     parser.add_argument(
@@ -383,6 +390,7 @@ def run(args: argparse.Namespace) -> int:
             "tolerance": tolerance,
             "process_variation": variation,
             "distance": args.distance,
+            "band": parse_number(args.band, "--band"),
         },
     )
     if isinstance(source, TableSource):

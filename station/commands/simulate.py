@@ -80,6 +80,11 @@ run out to their free travel (--free-travel, default -3/8 in or -9.525 mm)
 while the robot is away, then it returns with a short overshoot
 (--overshoot, default 20 resolutions) and settles. The c-th rest position is
 the model's c-th value; a reading shows where the robot is when it is sent.
+--settling V (one value or CH=V) makes the arrival a second-order one
+instead: the approach ends on the rest position and each axis rings about
+it, its first swing V past it, --settling-period seconds per swing, the
+envelope falling by e every --settling-decay seconds (a known overshoot and
+stabilisation time, ISO 9283 7.4-7.5).
 --hunt CH=V makes an axis hunt by +-V at rest on every --hunt-every N-th
 return instead of settling (a return the station must report, not record).
 """
@@ -207,6 +212,24 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     motion.add_argument(
         "--overshoot", metavar="V", help="how far past its rest position the robot returns"
+    )
+    motion.add_argument(
+        "--settling",
+        metavar="V",
+        help="a second-order arrival instead of --overshoot: each axis rings about its rest "
+        "position, its first swing V past it (one value, or CH=V,...)",
+    )
+    motion.add_argument(
+        "--settling-period",
+        default="0.1",
+        metavar="S",
+        help="with --settling: seconds per swing of the ringing (0.1)",
+    )
+    motion.add_argument(
+        "--settling-decay",
+        default="0.05",
+        metavar="S",
+        help="with --settling: the ringing's envelope falls by e every S seconds (0.05)",
     )
     motion.add_argument(
         "--return-gap",
@@ -481,13 +504,14 @@ def build_simulator(args: argparse.Namespace):
 def build_motion(args: argparse.Namespace, model, channels: list[str]):
     """The :class:`~station.instruments.motion.CycleMotion` of ``--cycle-period`` (None
     without it)."""
-    from station.instruments.motion import CycleMotion, default_free_travel
+    from station.instruments.motion import CycleMotion, Settling, default_free_travel
 
     motion_flags = [
         flag
         for flag, value in (
             ("--free-travel", args.free_travel),
             ("--overshoot", args.overshoot),
+            ("--settling", args.settling),
         )
         if value is not None
     ]
@@ -512,11 +536,28 @@ def build_motion(args: argparse.Namespace, model, channels: list[str]):
         if args.overshoot is not None
         else 20 * gauge.resolution
     )
+    settling = None
+    if args.settling is not None:
+        if args.overshoot is not None:
+            raise StationError(
+                "--overshoot and --settling are two ways to arrive: give one of them."
+            )
+        settling = Settling(
+            per_channel(args.settling, "--settling", channels),
+            period=positive_number(args.settling_period, "--settling-period"),
+            decay=positive_number(args.settling_decay, "--settling-decay"),
+        )
     hunt = {c: v for c, v in per_channel(args.hunt, "--hunt", channels).items() if v}
     hunt_every = positive_number(args.hunt_every, "--hunt-every", int)
     hunt_period = positive_number(args.hunt_period, "--hunt-period")
     return CycleMotion(
-        period, free, abs(overshoot), hunt=hunt, hunt_every=hunt_every, hunt_period=hunt_period
+        period,
+        free,
+        abs(overshoot),
+        hunt=hunt,
+        hunt_every=hunt_every,
+        hunt_period=hunt_period,
+        settling=settling,
     )
 
 
@@ -567,8 +608,17 @@ def show_joint(simulator) -> None:
 
 def robot_line(simulator) -> str:
     """How the simulated robot moves, for the start-up line on stderr."""
-    if simulator.motion is not None:
-        return f"; the robot leaves the fixture and returns every {simulator.motion.period:g} s"
+    motion = simulator.motion
+    if motion is not None:
+        line = f"; the robot leaves the fixture and returns every {motion.period:g} s"
+        settling = motion.settling
+        if settling is not None:
+            swings = ",".join(f"{c}={v:g}" for c, v in settling.overshoot.items())
+            line += (
+                f", ringing on arrival (first swing past the rest {swings}, "
+                f"{settling.period:g} s per swing, decay {settling.decay:g} s)"
+            )
+        return line
     if simulator.return_gap:
         return (
             f"; the robot moves to its next rest when the station pauses "

@@ -21,6 +21,13 @@ pure (no threads, no clock: the time is each reading's own ``t``), fed one readi
 
 So nothing is taken during motion, and one departure gives at most one set. :meth:`tick`
 advances the clock without a reading, so a timeout is reported even when the line goes quiet.
+
+With ``trace`` (points per return) the detector also keeps each return's **trace**: a row of
+every channel each time all of them have read again, from a few rows before the first arrival
+(the approach) until the set is taken, handed over with the ``settled`` event
+(:class:`ReturnTrace`). It is bounded: once it holds ``trace`` rows every other row is dropped
+and only every second row kept from then on (and so on), so a slow settling is kept whole at a
+coarser sampling interval, which the trace states.
 """
 
 from __future__ import annotations
@@ -38,6 +45,10 @@ DEFAULT_BAND_RESOLUTIONS = 100.0
 DEFAULT_STILL_RESOLUTIONS = 2.0
 DEFAULT_SETTLE = 0.5
 DEFAULT_TIMEOUT = 10.0
+TRACE_PREROLL = 8
+"""Rows of the approach kept before the first arrival: the trace shows its entry."""
+MAX_TRACE_POINTS = 2000
+"""The most rows a return's trace may be asked to keep (a line of the session file each)."""
 
 ArrivalState = Literal["waiting", "away", "returned"]
 EventKind = Literal["departed", "returned", "settled", "unsettled"]
@@ -67,6 +78,8 @@ class ArrivalConfig:
     centre: Mapping[str, float] = field(default_factory=dict)
     stop: StopSide = "low"
     free_travel: Mapping[str, float] = field(default_factory=dict)
+    trace: int = 0
+    """Rows of each return's trace to keep (0: none; see the module)."""
 
     def __post_init__(self) -> None:
         if self.band is not None and not self.band > 0:
@@ -79,6 +92,11 @@ class ArrivalConfig:
             raise StationError(f"The arrival settle time must be over 0 s, not {self.settle}.")
         if self.stop not in STOP_SIDES:
             raise StationError(f"The indicators' stop must be 'low' or 'high', not {self.stop!r}.")
+        if not 0 <= self.trace <= MAX_TRACE_POINTS or (0 < self.trace < 2 * TRACE_PREROLL):
+            raise StationError(
+                f"The arrival trace keeps 0 (none) or {2 * TRACE_PREROLL} to {MAX_TRACE_POINTS} "
+                f"points per return, not {self.trace}."
+            )
         if not self.timeout > self.settle:
             raise StationError(
                 f"The arrival timeout ({self.timeout:g} s) must be longer than the settle time "
@@ -88,6 +106,83 @@ class ArrivalConfig:
     def band_of(self, resolution: float) -> float:
         """The half-width of the working band of a channel of this ``resolution``."""
         return self.band if self.band is not None else DEFAULT_BAND_RESOLUTIONS * resolution
+
+
+@dataclass(frozen=True)
+class ReturnTrace:
+    """One return's trace: ``t`` the time of each row (the detector's clock), ``rows`` one
+    value per channel of ``channels`` each; ``every``: rows that came per row kept (1: all);
+    ``arrived``: the first arrival's time."""
+
+    channels: tuple[str, ...]
+    t: tuple[float, ...]
+    rows: tuple[tuple[float, ...], ...]
+    every: int
+    arrived: float
+
+
+class _TraceRecorder:
+    """Rows of every channel, complete each time all have read again; the approach's last
+    :data:`TRACE_PREROLL` rows until a return starts, then every row (decimated to the bound)."""
+
+    def __init__(self, channels: tuple[str, ...], limit: int) -> None:
+        self.channels = channels
+        self.limit = limit
+        self._pending: dict[str, float] = {}
+        self._preroll: deque[tuple[float, tuple[float, ...]]] = deque(maxlen=TRACE_PREROLL)
+        self._rows: list[tuple[float, tuple[float, ...]]] = []
+        self._recording = False
+        self._every = 1
+        self._count = 0
+
+    def feed(self, channel: str, value: float, t: float) -> None:
+        self._pending[channel] = value
+        if len(self._pending) < len(self.channels):
+            return
+        # Two ports' clocks may disagree by a hair: a trace's rows never go back in time.
+        last = self._rows[-1][0] if self._rows else (self._preroll[-1][0] if self._preroll else t)
+        row = (max(t, last), tuple(self._pending[c] for c in self.channels))
+        self._pending = {}
+        if not self._recording:
+            self._preroll.append(row)
+            return
+        if self._count % self._every == 0:
+            self._rows.append(row)
+            if len(self._rows) >= self.limit:
+                # Full: keep every other row, and from now on every other row of what comes.
+                self._rows = self._rows[::2]
+                self._every *= 2
+        self._count += 1
+
+    def start(self) -> None:
+        """A return began (the first arrival): the approach's rows open its trace."""
+        self._recording = True
+        self._rows = list(self._preroll)
+        self._count = len(self._rows)
+        self._every = 1
+
+    def take(self, arrived: float) -> ReturnTrace | None:
+        """The return's trace (None without two rows), and forget it."""
+        rows = self._rows
+        every = self._every
+        self.forget()
+        if len(rows) < 2:
+            return None
+        return ReturnTrace(
+            self.channels,
+            tuple(t for t, _ in rows),
+            tuple(values for _, values in rows),
+            every,
+            arrived,
+        )
+
+    def forget(self) -> None:
+        """Drop the return under way (it did not settle, or the detector was re-armed)."""
+        self._recording = False
+        self._rows = []
+        self._preroll.clear()
+        self._count = 0
+        self._every = 1
 
 
 @dataclass(frozen=True)
@@ -106,6 +201,8 @@ class ArrivalEvent(Generic[Item]):
     readings: Mapping[str, Item] = field(default_factory=dict)
     t_arrived: float | None = None
     message: str = ""
+    trace: ReturnTrace | None = None
+    """A ``settled`` event's trace of the return, when the detector keeps traces."""
 
 
 @dataclass
@@ -150,6 +247,9 @@ class ArrivalDetector(Generic[Item]):
         self.now = float("-inf")
         self._t_in_band = float("-inf")
         """When every channel last came (back) into its band."""
+        self._trace = (
+            _TraceRecorder(self.channels, self.config.trace) if self.config.trace else None
+        )
 
     def reset(self) -> None:
         """Forget the motion seen so far: only a departure after this counts (arm)."""
@@ -157,6 +257,8 @@ class ArrivalDetector(Generic[Item]):
         self.t_arrived = None
         for state in self._channels.values():
             state.window.clear()
+        if self._trace is not None:
+            self._trace.forget()
 
     def out_of_band(self) -> tuple[str, ...]:
         """Channels whose latest reading lies outside their working band."""
@@ -174,6 +276,8 @@ class ArrivalDetector(Generic[Item]):
             return []
         events = self.tick(t)
         state.latest = (t, value, item)
+        if self._trace is not None:
+            self._trace.feed(channel, value, t)
         outside = self.out_of_band()
         if self.state == "waiting":
             if outside:
@@ -187,6 +291,8 @@ class ArrivalDetector(Generic[Item]):
             self._t_in_band = t
             if self.t_arrived is None:
                 self.t_arrived = t
+                if self._trace is not None:
+                    self._trace.start()
             for each in self._channels.values():
                 each.window.clear()
                 each.window.append(each.latest)
@@ -216,6 +322,8 @@ class ArrivalDetector(Generic[Item]):
                 )
                 events.append(ArrivalEvent("departed", t, outside))
                 self.t_arrived = None
+                if self._trace is not None:
+                    self._trace.forget()
             return events
         state.window.append((t, value, item))
         self._trim(state, t)
@@ -224,7 +332,12 @@ class ArrivalDetector(Generic[Item]):
             arrived = self.t_arrived
             self.state = "waiting"
             self.t_arrived = None
-            events.append(ArrivalEvent("settled", t, self.channels, readings, arrived))
+            trace = (
+                self._trace.take(arrived)
+                if self._trace is not None and arrived is not None
+                else None
+            )
+            events.append(ArrivalEvent("settled", t, self.channels, readings, arrived, trace=trace))
         return events
 
     def tick(self, t: float) -> list[ArrivalEvent[Item]]:
@@ -246,6 +359,8 @@ class ArrivalDetector(Generic[Item]):
             "unsettled", self.now, moving, t_arrived=arrived, message=message
         )
         self.t_arrived = None
+        if self._trace is not None:
+            self._trace.forget()
         # Still back at the fixture (but moving), or away again: either way the next set needs
         # a new departure.
         self.state = "away" if self.out_of_band() else "waiting"
@@ -390,5 +505,8 @@ __all__ = [
     "DEFAULT_SETTLE",
     "DEFAULT_STILL_RESOLUTIONS",
     "DEFAULT_TIMEOUT",
+    "MAX_TRACE_POINTS",
+    "ReturnTrace",
+    "TRACE_PREROLL",
     "unsettled_message",
 ]

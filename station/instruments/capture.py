@@ -14,6 +14,7 @@ import time
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+from station.instruments.arrival import ReturnTrace
 from station.instruments.reader import GaugeReader, GaugeReading, TriggerTicket
 
 
@@ -39,6 +40,8 @@ class CaptureResult:
     at_stop: tuple[str, ...] = ()
     """Channels whose reading sits at the indicator's free-travel stop: the robot is away
     from the fixture, so the set measures the plungers, not the robot."""
+    trace: ReturnTrace | None = None
+    """An arrival set's trace of its return, when the trigger keeps traces."""
 
     @property
     def port_down(self) -> bool:

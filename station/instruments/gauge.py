@@ -315,6 +315,7 @@ class GaugeSet(SetCaptures, SetZeroing, SetFrameChecks):
                     dict(event.readings),
                     t_trigger=event.t_arrived if event.t_arrived is not None else event.t,
                     at_stop=self.at_stop(event.readings),
+                    trace=event.trace,
                 )
                 self._sets.append(result)
                 return result

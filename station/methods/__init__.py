@@ -3,7 +3,8 @@
 ``repeatability`` (report §2.6), ``relative_accuracy`` (§2.8), ``linearity`` (§2.9),
 ``gauge_check`` (a Type-1 study), ``gauge_linearity`` (AIAG's linearity and bias study),
 ``gage_rr`` (AIAG's crossed Gage R&R), ``joint_troubleshooting`` (§1.2, §2.8),
-``gain_schedule`` (Part IV) and ``positioning`` (ISO 230-2, one axis). The list is
+``gain_schedule`` (Part IV), ``positioning`` (ISO 230-2, one axis), ``pose_characteristics``
+(ISO 9283 §7.2–7.3) and ``stabilisation`` (ISO 9283 §7.4–7.5). The list is
 :data:`~station.methods.catalog.BUILT_IN`; a site's own come from its installed packages. A
 method package imports the contract and the shared modules beside it, never another method.
 """

@@ -23,6 +23,7 @@ from station.methods.pose_characteristics import METHOD as POSE_CHARACTERISTICS
 from station.methods.positioning import METHOD as POSITIONING
 from station.methods.relative_accuracy import METHOD as RELATIVE_ACCURACY
 from station.methods.repeatability import METHOD as REPEATABILITY
+from station.methods.stabilisation import METHOD as STABILISATION
 from station.procedures import AnalysisNeeds, discover_procedures, use_methods
 from station.session.model import Session
 
@@ -37,6 +38,7 @@ BUILT_IN: tuple[Method, ...] = (
     GAIN_SCHEDULE,
     POSITIONING,
     POSE_CHARACTERISTICS,
+    STABILISATION,
 )
 """The station's own methods; the first is the default (a procedure that declares none and
 whose steps imply none)."""

@@ -39,12 +39,20 @@ if TYPE_CHECKING:
 Layout = Literal["tidy", "wide"]
 """A CSV export's layout: a row per reading (tidy) or the table the method's analysis reads."""
 
-OPTIONS = ("reference", "tolerance", "process_variation", "order", "pool_above", "distance")
+OPTIONS = (
+    "reference",
+    "tolerance",
+    "process_variation",
+    "order",
+    "pool_above",
+    "distance",
+    "band",
+)
 """The values a command line may give a method's batch analysis (``station analyze``): a
 reference size, a tolerance, a process variation (6σ), a fit's order, the p above which a Gage
 R&R pools its interaction, the two poses a distance is measured between (the text
-``P2:P4=27.71``, which the method reads). A method names the ones it takes in
-:attr:`Method.options`."""
+``P2:P4=27.71``, which the method reads), the radius of a stabilisation band. A method
+names the ones it takes in :attr:`Method.options`."""
 
 
 # -- what a method is given and gives back -----------------------------------------------------

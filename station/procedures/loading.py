@@ -184,7 +184,9 @@ def _parse_arrival(
     if not table:
         return ArrivalConfig()
     where = "[arrival]"
-    check.only_keys(table, ("band", "still", "settle", "timeout", "stop", "free_travel"), where)
+    check.only_keys(
+        table, ("band", "still", "settle", "timeout", "stop", "free_travel", "trace"), where
+    )
     numbers = ("band", "still", "settle", "timeout")
     given: dict[str, Any] = {
         key: check.number(table, key, where) for key in table if key in numbers
@@ -198,6 +200,11 @@ def _parse_arrival(
         given["stop"] = table["stop"]
     if "free_travel" in table:
         given["free_travel"] = _free_travel(check, table["free_travel"], channels, where)
+    if "trace" in table:
+        trace = table["trace"]
+        if isinstance(trace, bool) or not isinstance(trace, int):
+            raise check.fail(where, "'trace' must be a whole number of points per return")
+        given["trace"] = trace
     try:
         return ArrivalConfig(**given)
     except StationError as error:

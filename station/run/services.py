@@ -25,6 +25,7 @@ from station.run.steps import handler_for
 from station.run.steps.base import PlanItem, StepHandler
 
 if TYPE_CHECKING:
+    from station.instruments.arrival import ReturnTrace
     from station.instruments.capture import CaptureResult
 
 
@@ -237,6 +238,25 @@ class StepServices:
         """A set not recorded, with the operator's sentence."""
         self.say("warning", message)
         return CycleOutcome(recorded=False, message=message)
+
+    def write_trace(self, item: PlanItem, cycle: int, trace: ReturnTrace) -> None:
+        """Write the trace of the return that ended in ``cycle`` (the step's channels of it),
+        after its reading: times in seconds after the first arrival, rounded to the µs the
+        reading clock is worth."""
+        columns = [i for i, c in enumerate(trace.channels) if c in item.step.channels]
+        if not columns:
+            return
+        self.append(
+            "trace",
+            notify=False,
+            cycle=cycle,
+            step=item.step.id,
+            channels=[trace.channels[i] for i in columns],
+            times=[round(t - trace.arrived, 6) for t in trace.t],
+            values=[[row[i] for i in columns] for row in trace.rows],
+            every=trace.every,
+            t0=trace.arrived,
+        )
 
     def append(self, event_type: str, *, notify: bool = True, **fields: Any) -> dict[str, Any]:
         """Write one event (fsynced when this returns). A failed write marks the engine failed

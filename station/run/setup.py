@@ -181,6 +181,7 @@ class SessionSetup:
             "timeout": arrival.timeout,
             "stop": arrival.stop,
             **({"free_travel": dict(arrival.free_travel)} if arrival.free_travel else {}),
+            **({"trace": arrival.trace} if arrival.trace else {}),
         }
 
     def header_fields(self) -> dict[str, Any]:

@@ -50,7 +50,7 @@ from station.session.lines import (
     looks_like_session,
     not_a_session_error,
 )
-from station.session.replay import Cycle, Replay, SampleBatch, Status
+from station.session.replay import Cycle, Replay, SampleBatch, Status, Trace
 
 if TYPE_CHECKING:
     import numpy as np
@@ -100,6 +100,8 @@ class Session:
     torn: TornTail | None = None
     acks: tuple[Mapping[str, Any], ...] = ()
     """Every ``ack`` event in order: an alarm acknowledged with its cause."""
+    traces: tuple[Trace, ...] = ()
+    """Every ``trace`` event in order: a return's trace under the arrival trigger."""
 
     @classmethod
     def from_replay(cls, replay: Replay, path: Path, lines: int, torn: TornTail | None) -> Session:
@@ -123,6 +125,7 @@ class Session:
             lines=lines,
             torn=torn,
             acks=tuple(replay.acks),
+            traces=tuple(replay.traces),
         )
 
     @property

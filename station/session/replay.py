@@ -31,6 +31,7 @@ EVENT_TYPES: tuple[str, ...] = (
     "ack",
     "instrument",
     "samples",
+    "trace",
     "resume",
     "interrupted",
     "finish",
@@ -94,6 +95,31 @@ class SampleBatch:
         return {channel: table[:, index] for index, channel in enumerate(self.channels)}
 
 
+@dataclass(frozen=True)
+class Trace:
+    """One ``trace`` event: the gauges' trace of one return under the arrival trigger (the
+    approach, the settling, the rest), recorded after the cycle it ended in. ``t`` is each
+    row's seconds after ``t0`` (the event's ``times``; ``t0`` the first arrival, on the reading
+    clock), ``every`` how many rows came per row kept (the trace is bounded: a long one is
+    decimated)."""
+
+    seq: int
+    cycle: int
+    step: str
+    channels: tuple[str, ...]
+    t: tuple[float, ...]
+    values: tuple[tuple[float, ...], ...]
+    every: int = 1
+    t0: float | None = None
+
+    def as_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """The times and the rows (one column per channel) as arrays."""
+        import numpy as np
+
+        rows = np.asarray(self.values, dtype=float).reshape(len(self.values), len(self.channels))
+        return np.asarray(self.t, dtype=float), rows
+
+
 def _is_number(value: Any) -> bool:
     if not isinstance(value, int | float) or isinstance(value, bool):
         return False
@@ -141,6 +167,7 @@ class Replay:
     input_events: list[dict[str, Any]] = field(default_factory=list)
     zeroes: list[dict[str, Any]] = field(default_factory=list)
     samples: list[SampleBatch] = field(default_factory=list)
+    traces: list[Trace] = field(default_factory=list)
     confirmed_steps: list[str] = field(default_factory=list)
     status: Status = "running"
     last_seq: int = 0
@@ -158,6 +185,7 @@ class Replay:
         self.checks_only = True
         self.events.clear()
         self.samples.clear()
+        self.traces.clear()
         self.notes.clear()
         self.input_events.clear()
 
@@ -248,6 +276,20 @@ class Replay:
                     channels=tuple(record["channels"]),
                     values=tuple(tuple(float(v) for v in row) for row in record["values"]),
                     t_mono=tuple(float(v) for v in record.get("t_mono") or ()),
+                )
+            )
+        elif kind == "trace" and not self.checks_only:
+            t0 = record.get("t0")
+            self.traces.append(
+                Trace(
+                    seq=record["seq"],
+                    cycle=record["cycle"],
+                    step=record["step"],
+                    channels=tuple(record["channels"]),
+                    t=tuple(float(v) for v in record["times"]),
+                    values=tuple(tuple(float(v) for v in row) for row in record["values"]),
+                    every=int(record.get("every", 1)),
+                    t0=_optional_number(t0),
                 )
             )
         elif kind == "step":
@@ -383,7 +425,8 @@ def _check_note(replay: Replay, record: Mapping[str, Any]) -> None:
     _need_text(record, "text")
 
 
-def _check_samples(replay: Replay, record: Mapping[str, Any]) -> None:
+def _check_rows(replay: Replay, record: Mapping[str, Any], kind: str) -> list[Any]:
+    """A ``samples`` or ``trace`` event's ``step``, ``channels`` and ``values``; the rows."""
     _need_text(record, "step")
     channels = record.get("channels")
     if (
@@ -391,13 +434,40 @@ def _check_samples(replay: Replay, record: Mapping[str, Any]) -> None:
         or not channels
         or not all(isinstance(c, str) and c in replay.header["channels"] for c in channels)
     ):
-        raise ValueError("a samples event needs 'channels', a list of the session's channels")
+        raise ValueError(f"a {kind} event needs 'channels', a list of the session's channels")
     values = record.get("values")
     if not isinstance(values, list) or not all(
         isinstance(row, list) and len(row) == len(channels) and all(map(_is_reading, row))
         for row in values
     ):
-        raise ValueError("a samples event needs 'values', rows of one number per channel")
+        raise ValueError(f"a {kind} event needs 'values', rows of one number per channel")
+    return values
+
+
+def _check_trace(replay: Replay, record: Mapping[str, Any]) -> None:
+    """A return's trace: ``cycle`` (a recorded cycle), ``step``, ``channels``, ``values`` (rows),
+    ``times`` (one per row, s after ``t0``, never going back), ``every`` (rows per row kept)."""
+    cycle = _need_cycle(record)
+    if cycle not in replay.cycles:
+        raise ValueError(f"a trace event names cycle {cycle}, which is not a recorded cycle")
+    values = _check_rows(replay, record, "trace")
+    times = record.get("times")
+    if (
+        not isinstance(times, list)
+        or len(times) != len(values)
+        or not all(map(_is_number, times))
+        or any(b < a for a, b in zip(times, times[1:], strict=False))
+    ):
+        raise ValueError("a trace event's 'times' must hold one time per row, never going back")
+    every = record.get("every", 1)
+    if not isinstance(every, int) or isinstance(every, bool) or every < 1:
+        raise ValueError("a trace event's 'every' must be a whole number, 1 or more")
+    if "t0" in record and not _is_number(record["t0"]):
+        raise ValueError("a trace event's 't0' must be a number")
+
+
+def _check_samples(replay: Replay, record: Mapping[str, Any]) -> None:
+    values = _check_rows(replay, record, "samples")
     t_mono = record.get("t_mono")
     if t_mono is not None and (
         not isinstance(t_mono, list)
@@ -439,6 +509,7 @@ _EVENT_CHECKS = {
     "ack": _check_ack,
     "instrument": _check_free,
     "samples": _check_samples,
+    "trace": _check_trace,
     "resume": _check_free,
     "interrupted": _check_free,
     "finish": _check_free,

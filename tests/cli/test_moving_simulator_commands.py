@@ -52,6 +52,9 @@ def test_read_prints_one_set_per_round_trip_and_what_the_frames_say() -> None:
         (["--cycle-period", "0"], "--cycle-period"),
         (["--cycle-period", "1", "--model", "bar"], "moves where its procedure's steps take it"),
         (["--cycle-period", "1", "--hunt-every", "0"], "--hunt-every"),
+        (["--settling", "0.01"], "--settling needs --cycle-period"),
+        (["--cycle-period", "1", "--settling", "0.01", "--overshoot", "0.01"], "give one of them"),
+        (["--cycle-period", "1", "--settling", "0.01", "--settling-decay", "0"], "decay"),
     ],
 )
 def test_motion_options_that_cannot_work_are_one_line_errors(args, message) -> None:

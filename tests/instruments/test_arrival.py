@@ -145,3 +145,56 @@ def test_reset_forgets_a_departure() -> None:
 def test_impossible_parameters_are_refused_with_a_sentence(kwargs, words) -> None:
     with pytest.raises(StationError, match=words):
         ArrivalConfig(**kwargs)
+
+
+def test_a_settled_return_hands_over_its_trace_from_the_approach_to_the_set() -> None:
+    detector = ArrivalDetector(("x", "y"), RES, ArrivalConfig(band=0.1, settle=0.2, trace=100))
+    approach = [{"x": v, "y": v} for v in (-9.5, -5.0, -1.0, -0.3)]
+    samples = at(0.0, 10) + at(-9.5, 10) + approach + [{"x": 0.02, "y": 0.015}] * 3 + at(0.0, 30)
+    events, _ = feed_all(detector, samples)
+    settled = events[-1]
+    assert settled.kind == "settled"
+    trace = settled.trace
+    assert trace is not None and trace.channels == ("x", "y") and trace.every == 1
+    # The approach's last rows (the free travel, then the ramp) open it, 8 with the arrival's.
+    assert trace.rows[:7] == ((-9.5, -9.5),) * 4 + tuple((v, v) for v in (-5.0, -1.0, -0.3))
+    assert trace.rows[7] == (0.02, 0.015) and trace.arrived == pytest.approx(0.48)
+    # A row per poll (both channels read), until the set was taken (its poll's x decided it,
+    # before y made the row whole).
+    assert trace.t[-1] == pytest.approx(settled.t - 0.02)
+    assert all(b - a == pytest.approx(0.02) for a, b in zip(trace.t, trace.t[1:], strict=False))
+    assert trace.rows[-1] == (0.0, 0.0)
+
+
+def test_a_long_trace_is_decimated_to_its_bound_and_says_so() -> None:
+    config = ArrivalConfig(band=0.1, settle=0.2, timeout=20.0, trace=20)
+    detector = ArrivalDetector(("x",), RES, config)
+    ringing = [{"x": 0.01 * (-1) ** i} for i in range(100)]  # 2 s of swinging in the band
+    events, _ = feed_all(
+        detector, [{"x": 0.0}] * 5 + [{"x": -9.5}] * 5 + ringing + [{"x": 0.0}] * 30
+    )
+    trace = events[-1].trace
+    assert trace is not None and len(trace.rows) <= 20
+    # 8 + 100 + about 11 rows came: every 8th kept, so 0.16 s apart, the return whole.
+    assert trace.every == 8
+    assert all(b - a == pytest.approx(0.16) for a, b in zip(trace.t, trace.t[1:], strict=False))
+    # From 7 rows before the arrival at 0.2 s to within a kept interval of the set.
+    assert trace.t[0] == pytest.approx(0.06) and trace.t[-1] >= events[-1].t - 0.16
+
+
+def test_a_return_that_does_not_settle_leaves_no_trace_for_the_next() -> None:
+    config = ArrivalConfig(band=0.1, settle=0.2, timeout=1.0, trace=100)
+    detector = ArrivalDetector(("x",), RES, config)
+    hunting = [{"x": 0.005 * (-1) ** i} for i in range(80)]
+    trip = [{"x": 0.0}] * 5 + [{"x": -9.5}] * 5
+    events, t = feed_all(detector, trip + hunting)
+    assert [e.kind for e in events] == ["departed", "returned", "unsettled"]
+    events, _ = feed_all(detector, [{"x": -9.5}] * 5 + [{"x": 0.0}] * 20, t0=t)
+    trace = events[-1].trace
+    assert events[-1].kind == "settled" and trace is not None
+    assert max(abs(row[0]) for row in trace.rows[8:]) == 0.0  # none of the hunting return's
+
+
+def test_a_trace_bound_too_small_to_hold_the_approach_is_refused() -> None:
+    with pytest.raises(StationError, match="trace"):
+        ArrivalConfig(trace=5)

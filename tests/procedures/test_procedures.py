@@ -351,6 +351,7 @@ def test_the_analysis_kind_defaults_by_step_kinds(tmp_path: Path) -> None:
         "gain_schedule": "gain_schedule",
         "positioning": "positioning",
         "pose_characteristics": "pose_characteristics",
+        "stabilisation": "stabilisation",
     }
 
 

@@ -265,3 +265,36 @@ def test_the_session_tests_write_the_header_production_writes(session_factory) -
     assert header["instruments"]["trigger"] == "poll"
     assert header["instruments"]["ports"][0]["map"] == {"1": "x", "2": "y", "3": "z"}
     assert not hasattr(journal, "session_header")
+
+
+def test_a_returns_trace_is_written_after_its_cycle_and_replayed(tmp_path: Path) -> None:
+    trace = {
+        "step": "cycles",
+        "channels": ["x", "y"],
+        "times": [-0.02, 0.0, 0.02],
+        "values": [[-0.3, -0.3], [0.02, 0.01], [0.0, 0.0]],
+        "every": 2,
+        "t0": 812.5,
+    }
+    with SessionWriter.create(tmp_path, _header()) as writer:
+        with pytest.raises(StationError, match="names cycle 1, which is not a recorded cycle"):
+            writer.append("trace", cycle=1, **trace)
+        writer.append("reading", **reading_fields(1))
+        with pytest.raises(StationError, match="'times' must hold one time per row"):
+            writer.append("trace", cycle=1, **{**trace, "times": [0.0, -0.02, 0.02]})
+        with pytest.raises(StationError, match="rows of one number per channel"):
+            writer.append("trace", cycle=1, **{**trace, "values": [[0.0], [0.0], [0.0]]})
+        with pytest.raises(StationError, match="'every'"):
+            writer.append("trace", cycle=1, **{**trace, "every": 0})
+        writer.append("trace", cycle=1, **trace)
+        path = writer.path
+    (found,) = load_session(path).traces
+    assert (found.cycle, found.step, found.channels, found.every, found.t0) == (
+        1,
+        "cycles",
+        ("x", "y"),
+        2,
+        812.5,
+    )
+    t, rows = found.as_arrays()
+    assert t.tolist() == [-0.02, 0.0, 0.02] and rows[:, 1].tolist() == [-0.3, 0.01, 0.0]

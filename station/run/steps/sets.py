@@ -67,6 +67,9 @@ class SetStep(StepHandler):
             return outcome
         readings = {ch: result.readings[ch] for ch in item.step.channels}
         outcome = run.write_cycle(item, readings, by, **self.cycle_fields(run, item))
+        trace = getattr(result, "trace", None)
+        if trace is not None and outcome.cycle is not None:
+            run.write_trace(item, outcome.cycle.cycle, trace)
         self.after_cycle(run, item, by)
         return outcome
 
