@@ -111,6 +111,9 @@ class SessionIndex:
         if self.path is not None:
             try:
                 return self._figures(folder, paths)
+            except OSError as error:  # its folder cannot be made (a read-only data folder)
+                self._close()
+                self._do_without(f"it cannot be made ({error.strerror})")
             except sqlite3.DatabaseError as error:
                 self._close()
                 if not _damaged(error):

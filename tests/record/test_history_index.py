@@ -120,6 +120,26 @@ def test_an_index_that_cannot_be_kept_is_done_without(sessions, capsys):
         assert robot_history(sessions, "KSC-7", index=index) == expected
 
 
+@pytest.mark.parametrize("where", ["a folder at its name", "a data folder it cannot make"])
+def test_an_index_that_cannot_be_opened_is_done_without(sessions, monkeypatch, where):
+    robot_sessions(sessions, "KSC-7", 2)
+    expected = robot_history(sessions, "KSC-7")
+    if where == "a folder at its name":
+        index_path().mkdir(parents=True)
+        why = "unable to open database file"
+    else:
+
+        def read_only(folder):
+            raise PermissionError(13, "Permission denied", str(folder))
+
+        monkeypatch.setattr(index_module, "make_folders", read_only)
+        why = "cannot be made (Permission denied)"
+    with SessionIndex.open() as index:
+        assert robot_history(sessions, "KSC-7", index=index) == expected
+        (warning,) = index.warnings
+    assert why in warning and "the session files are read instead" in warning
+
+
 def test_a_second_writer_holding_the_index_is_waited_for_then_done_without(sessions, monkeypatch):
     robot_sessions(sessions, "KSC-7", 2)
     with SessionIndex.open() as first:
