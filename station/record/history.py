@@ -403,7 +403,7 @@ def robot_history(
     if index is None:
         files = [session_figures(path, robot=robot) for path in session_paths(folder)]
     else:
-        files = index.figures(folder)
+        files = index.figures(folder, robot=robot)
     if not any(f.robot == robot for f in files):
         raise StationError(f"no session of robot {robot!r} in {folder}; check the name.")
     return _history(folder, robot, files)

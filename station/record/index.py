@@ -104,13 +104,15 @@ class SessionIndex:
 
     # -- reading a folder -----------------------------------------------------------------------
 
-    def figures(self, folder: Path) -> list[SessionFigures]:
+    def figures(self, folder: Path, *, robot: str | None = None) -> list[SessionFigures]:
         """The figures of every session file of ``folder``, from the index where the file has
-        not changed since it was read, from the file otherwise (the index then keeps them)."""
+        not changed since it was read, from the file otherwise (the index then keeps them).
+        With ``robot``, only that robot's sessions are analysed: the others are loaded (their
+        robot and date, or why they cannot be read, are kept) and analysed when asked for."""
         paths = session_paths(folder)
         if self.path is not None:
             try:
-                return self._figures(folder, paths)
+                return self._figures(folder, paths, robot)
             except OSError as error:  # its folder cannot be made (a read-only data folder)
                 self._close()
                 self._do_without(f"it cannot be made ({error.strerror})")
@@ -122,13 +124,15 @@ class SessionIndex:
                     self._rebuild(error)
                     if self.path is not None:
                         try:
-                            return self._figures(folder, paths)
+                            return self._figures(folder, paths, robot)
                         except sqlite3.DatabaseError as again:
                             self._close()
                             self._do_without(f"it cannot be used ({again})")
-        return [session_figures(path) for path in paths]
+        return [session_figures(path, robot=robot) for path in paths]
 
-    def _figures(self, folder: Path, paths: Sequence[Path]) -> list[SessionFigures]:
+    def _figures(
+        self, folder: Path, paths: Sequence[Path], robot: str | None
+    ) -> list[SessionFigures]:
         db = self._connect()
         key = str(folder.resolve())
         known = {
@@ -146,10 +150,10 @@ class SessionIndex:
             row = known.get(path.name)
             if stamp is not None and row is not None and tuple(row[1:5]) == stamp:
                 kept = _from_row(path, row[5:])
-                if kept is not None:
+                if kept is not None and not _wanted_unanalysed(kept, robot):
                     found.append(kept)
                     continue
-            figures = session_figures(path)
+            figures = session_figures(path, robot=robot)
             found.append(figures)
             if stamp is not None:
                 fresh.append((key, path.name, *stamp, *_to_row(figures)))
@@ -241,6 +245,13 @@ def _damaged(error: sqlite3.DatabaseError) -> bool:
         text = str(error).lower()
         return "malformed" in text or "not a database" in text
     return True
+
+
+def _wanted_unanalysed(figures: SessionFigures, robot: str | None) -> bool:
+    """True for a kept session that was loaded but not analysed (another robot's, read for
+    one robot's history) when ``robot``'s (or every robot's, None) figures are wanted."""
+    unanalysed = figures.robot is not None and figures.entry is None and figures.error is None
+    return unanalysed and robot in (None, figures.robot)
 
 
 def _stamp(path: Path) -> _Stamp | None:

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+import station.record.history as history_module
 import station.record.index as index_module
 from station.cli import main
 from station.record.baseline import store_baseline
@@ -62,6 +63,27 @@ def test_the_index_gives_the_history_the_files_give_and_then_reads_none(sessions
         marked = robot_history(sessions, "KSC-7", index=index)
     assert [e.baseline for e in marked.entries] == [False, True, False, False, False]
     assert marked == robot_history(sessions, "KSC-7")
+
+
+def test_another_robots_sessions_are_analysed_only_when_asked_for(sessions, monkeypatch):
+    robot_sessions(sessions, "KSC-7", 3)
+    robot_sessions(sessions, "other", 3, seed=7)
+    analysed: list[str] = []
+    original = history_module.analyse_loaded
+
+    def counted(session):
+        analysed.append(session.robot)
+        return original(session)
+
+    monkeypatch.setattr(history_module, "analyse_loaded", counted)
+    with SessionIndex.open() as index:
+        robot_history(sessions, "KSC-7", index=index)
+        assert analysed == ["KSC-7"] * 3  # the others' files are loaded, not analysed
+        other = robot_history(sessions, "other", index=index)
+        assert analysed == ["KSC-7"] * 3 + ["other"] * 3
+        fleet = fleet_history(sessions, index=index)
+        assert len(analysed) == 6  # every file's figures are in the index now
+    assert other == robot_history(sessions, "other") and fleet == fleet_history(sessions)
 
 
 def test_a_changed_added_or_deleted_file_is_noticed(sessions):
