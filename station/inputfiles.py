@@ -9,9 +9,11 @@ those is refused with one sentence before a byte is read.
 from __future__ import annotations
 
 import errno
+import io
 import os
 import stat
 from pathlib import Path
+from typing import Any, BinaryIO
 
 from station.errors import StationError
 from station.plain import plain
@@ -48,6 +50,15 @@ def read_input_bytes(path: str | os.PathLike[str], what: str, limit: int) -> byt
     """The bytes of the regular file ``path`` (see :func:`check_regular_file`), at most
     ``limit`` of them: a larger file is a StationError saying so. Opened without blocking, so a
     FIFO put in place after the check cannot hang the read."""
+    with open_input_file(path, what, limit) as handle:
+        return b"".join(iter(lambda: handle.read(MEBIBYTE), b""))
+
+
+def open_input_file(path: str | os.PathLike[str], what: str, limit: int) -> BinaryIO:
+    """The regular file ``path`` (see :func:`check_regular_file`) open to read its bytes,
+    which stop with a StationError saying so past ``limit`` of them. Opened without blocking,
+    so a FIFO put in place after the check cannot hang the read; a reader that streams the
+    file (``station verify``) holds a line at a time, not the file."""
     path = Path(path)
     check_regular_file(path, what)
     try:
@@ -60,24 +71,43 @@ def read_input_bytes(path: str | os.PathLike[str], what: str, limit: int) -> byt
         if not stat.S_ISREG(os.fstat(fd).st_mode):
             raise StationError(f"{_shown(path)} is not a regular file; give a regular {what}.")
         os.set_blocking(fd, True)
-        chunks: list[bytes] = []
-        total = 0
-        while True:
-            chunk = os.read(fd, min(MEBIBYTE, limit + 1 - total))
-            if not chunk:
-                break
-            chunks.append(chunk)
-            total += len(chunk)
-            if total > limit:
-                raise StationError(
-                    f"{_shown(path)} is larger than {limit // MEBIBYTE} MiB, more than a {what} "
-                    "can be; check that it is the right file."
-                )
-    except OSError as error:
-        raise StationError(f"cannot read {what} {_shown(path)}: {error.strerror}") from None
-    finally:
+    except BaseException:
         os.close(fd)
-    return b"".join(chunks)
+        raise
+    return io.BufferedReader(_BoundedFile(fd, path, what, limit), buffer_size=MEBIBYTE)
+
+
+class _BoundedFile(io.RawIOBase):
+    """A file descriptor read up to a bound: reading past ``limit`` bytes is a StationError
+    saying the file is too large, and a failed read one naming the file."""
+
+    def __init__(self, fd: int, path: Path, what: str, limit: int) -> None:
+        super().__init__()
+        self._fd, self._path, self._what, self._limit = fd, path, what, limit
+        self._total = 0
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: Any) -> int:
+        try:
+            count = os.readv(self._fd, [buffer])
+        except OSError as error:
+            raise StationError(
+                f"cannot read {self._what} {_shown(self._path)}: {error.strerror}"
+            ) from None
+        self._total += count
+        if self._total > self._limit:
+            raise StationError(
+                f"{_shown(self._path)} is larger than {self._limit // MEBIBYTE} MiB, more than a "
+                f"{self._what} can be; check that it is the right file."
+            )
+        return count
+
+    def close(self) -> None:
+        if not self.closed:
+            os.close(self._fd)
+        super().close()
 
 
 def _shown(path: Path) -> str:

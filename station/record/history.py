@@ -21,10 +21,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import datetime, timedelta
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -32,9 +32,10 @@ from station.analysis.diagnostics import p_phrase
 from station.errors import StationError
 from station.record.baseline import baseline_for
 from station.record.content import parse_time
-from station.record.source import analyse_session
+from station.record.source import AnalysedSession, analyse_loaded
 from station.record.text import plain
-from station.session.store import list_sessions
+from station.session.model import load_session
+from station.session.store import session_paths
 from station.text import (
     UNDEFINED,
     format_figure,
@@ -42,6 +43,9 @@ from station.text import (
     format_spread,
     overall_judgement,
 )
+
+if TYPE_CHECKING:
+    from station.record.index import SessionIndex
 
 SECONDS_PER_DAY = 86400.0
 
@@ -130,8 +134,43 @@ class RobotHistory:
     """The latest session's gauge step, which the charts and trends are written at."""
 
 
-def _entry(path: Path, baseline_session: str | None) -> HistoryEntry:
-    analysed = analyse_session(path)
+@dataclass(frozen=True)
+class SessionFigures:
+    """What one session file gives a history: whose it is, when, and its figures, or why it
+    could not be read. What the session index keeps of a file (:mod:`station.record.index`)."""
+
+    path: Path
+    robot: str | None
+    """None when the file does not load (then ``error`` says why)."""
+    created: str = ""
+    session_id: str = ""
+    entry: HistoryEntry | None = None
+    """None when the file could not be read or analysed (``error``), or was not analysed
+    (another robot's, read for a single robot's history)."""
+    error: str | None = None
+
+
+def session_figures(path: Path, *, robot: str | None = None) -> SessionFigures:
+    """The figures of the session file ``path``, read-only; a file that cannot be read or
+    analysed gives its error, never raises it. With ``robot``, another robot's session is
+    loaded (its chain checked: a damaged file is named in every history) but not analysed."""
+    try:
+        session = load_session(path, recover=False)
+    except StationError as error:
+        return SessionFigures(path, None, error=error.message)
+    found = SessionFigures(path, session.robot, session.created, session.session_id)
+    if robot is not None and session.robot != robot:
+        return found
+    try:
+        return replace(found, entry=_entry(analyse_loaded(session)))
+    except StationError as error:
+        return replace(found, error=error.message)
+
+
+def _entry(analysed: AnalysedSession) -> HistoryEntry:
+    """A history's line of ``analysed`` (``baseline`` is marked when a history is built: the
+    robot's baseline can change while the file does not)."""
+    path = analysed.path
     session = analysed.session
     channels: dict[str, ChannelFigures] = {}
     rp = None
@@ -169,7 +208,6 @@ def _entry(path: Path, baseline_session: str | None) -> HistoryEntry:
         channels=channels,
         verdict=verdict,
         anchor=session.last_hash,
-        baseline=baseline_session is not None and session.session_id == baseline_session,
         problem=analysed.problem,
         unit=session.unit,
         resolution=float(recorded) if isinstance(recorded, int | float) and recorded > 0 else None,
@@ -354,28 +392,38 @@ def _trends(
     return tuple(trends)
 
 
-def robot_history(folder: str | Path, robot: str) -> RobotHistory:
+def robot_history(
+    folder: str | Path, robot: str, *, index: SessionIndex | None = None
+) -> RobotHistory:
     """Every session of ``robot`` (exact name) in ``folder``, oldest first, with the trends.
     Files that do not load are left out and listed in ``skipped`` with why. StationError when
-    the robot has no session there."""
+    the robot has no session there. With ``index`` the figures of the files that did not
+    change since it last read them come from it (the same history, from a cache)."""
     folder = Path(folder)
-    listed = list_sessions(folder)
-    skipped = [(s.path, s.error) for s in listed if s.error is not None]
-    summaries = [s for s in listed if s.error is None and s.robot == robot]
-    if not summaries:
+    if index is None:
+        files = [session_figures(path, robot=robot) for path in session_paths(folder)]
+    else:
+        files = index.figures(folder, robot=robot)
+    if not any(f.robot == robot for f in files):
         raise StationError(f"no session of robot {robot!r} in {folder}; check the name.")
+    return _history(folder, robot, files)
+
+
+def _history(folder: Path, robot: str, files: Sequence[SessionFigures]) -> RobotHistory:
+    """The history of ``robot`` from the figures of the folder's files."""
     try:
         baseline = baseline_for(robot)
     except StationError:
         baseline = None  # a damaged baseline must not hide the history; `baseline` says why
     baseline_session = None if baseline is None else str(baseline.get("session"))
-    summaries.sort(key=lambda s: (s.created, s.path.name))
-    entries = []
-    for summary in summaries:
-        try:
-            entries.append(_entry(summary.path, baseline_session))
-        except StationError as error:
-            skipped.append((summary.path, error.message))
+    # Another robot's file is named only when it does not load at all (whose it is is unknown).
+    skipped = [(f.path, f.error) for f in files if f.error is not None and f.robot in (None, robot)]
+    mine = sorted((f for f in files if f.robot == robot), key=lambda f: (f.created, f.path.name))
+    entries = [
+        replace(f.entry, baseline=f.session_id == baseline_session)
+        for f in mine
+        if f.entry is not None
+    ]
     unit = entries[-1].unit if entries else ""
     resolution = entries[-1].resolution if entries else None
     return RobotHistory(
@@ -388,6 +436,80 @@ def robot_history(folder: str | Path, robot: str) -> RobotHistory:
         skipped=tuple(sorted(skipped)),
         resolution=resolution,
     )
+
+
+@dataclass(frozen=True)
+class RobotLine:
+    """One robot of ``station history --all``: its latest session and its trend in a word."""
+
+    robot: str
+    sessions: int
+    latest: HistoryEntry
+    trend: str
+    """:func:`trend_word` of its trends."""
+    unit: str
+
+
+@dataclass(frozen=True)
+class FleetHistory:
+    """Every robot of a sessions folder, one line each, and the files that could not be read."""
+
+    folder: Path
+    robots: tuple[RobotLine, ...]
+    skipped: tuple[tuple[Path, str], ...] = ()
+
+
+def trend_word(trends: Sequence[Trend]) -> str:
+    """A robot's trend in a word: ``falling`` when some channel's Cpk falls significantly
+    (wear), ``rising`` when one rises and none falls, ``drifting`` when no Cpk moves
+    significantly but a mean does, ``steady`` when nothing does, ``-`` when there are too
+    few sessions for a trend."""
+
+    def cpk_moves(t: Trend, down: bool) -> bool:
+        if t.cpk_ci_low is None or t.cpk_ci_high is None:
+            return False
+        return t.cpk_ci_high < 0 if down else t.cpk_ci_low > 0
+
+    if not trends:
+        return "-"
+    if any(cpk_moves(t, down=True) for t in trends):
+        return "falling"
+    if any(cpk_moves(t, down=False) for t in trends):
+        return "rising"
+    return "drifting" if any(t.significant for t in trends) else "steady"
+
+
+def fleet_history(folder: str | Path, *, index: SessionIndex | None = None) -> FleetHistory:
+    """One line per robot of ``folder`` (by name): its latest session's verdict and figures
+    and its trend, robots in name order; the files that could not be read in ``skipped``.
+    A robot none of whose files could be read has no line, only its files in ``skipped``."""
+    folder = Path(folder)
+    if index is None:
+        files = [session_figures(path) for path in session_paths(folder)]
+    else:
+        files = index.figures(folder)
+    lines = []
+    for robot in sorted({f.robot for f in files if f.robot is not None}, key=str.casefold):
+        history = _history(folder, robot, files)
+        if history.entries:
+            lines.append(
+                RobotLine(
+                    robot=robot,
+                    sessions=len(history.entries),
+                    latest=history.entries[-1],
+                    trend=trend_word(history.trends),
+                    unit=history.unit,
+                )
+            )
+    skipped = sorted((f.path, f.error) for f in files if f.error is not None)
+    return FleetHistory(folder=folder, robots=tuple(lines), skipped=tuple(skipped))
+
+
+def lowest_cpk(entry: HistoryEntry) -> float | None:
+    """The lowest Cpk of the session's channels (the one its verdict turns on); None when no
+    channel has one."""
+    cpks = [c.cpk for c in entry.channels.values() if c.cpk is not None and math.isfinite(c.cpk)]
+    return min(cpks, default=None)
 
 
 def text_chart(
@@ -524,4 +646,61 @@ def format_history(history: RobotHistory) -> list[str]:
     if history.skipped:
         lines += ["", f"Left out ({len(history.skipped)} files that could not be read):"]
         lines += [f"  {plain(path.name)}: {plain(why)}" for path, why in history.skipped]
+    return lines
+
+
+def fleet_json(fleet: FleetHistory) -> dict[str, Any]:
+    """The JSON document of ``station history --all --json``."""
+
+    def number(value: float | None) -> float | None:
+        return None if value is None or not math.isfinite(value) else float(value)
+
+    return {
+        "folder": str(fleet.folder),
+        "robots": [
+            {
+                "robot": line.robot,
+                "sessions": line.sessions,
+                "latest": line.latest.created,
+                "file": line.latest.path.name,
+                "procedure": line.latest.procedure,
+                "verdict": line.latest.verdict,
+                "rp": number(line.latest.rp),
+                "cpk": number(lowest_cpk(line.latest)),
+                "unit": line.unit,
+                "trend": line.trend,
+            }
+            for line in fleet.robots
+        ],
+        "skipped": [{"file": path.name, "error": why} for path, why in fleet.skipped],
+    }
+
+
+def format_fleet(fleet: FleetHistory) -> list[str]:
+    """The text of ``station history --all``: one line per robot (latest session's date,
+    verdict, RP and lowest Cpk, the trend in a word), fitting 80 columns."""
+    sessions = sum(line.sessions for line in fleet.robots)
+    lines = [f"Robots in the sessions folder: {len(fleet.robots)} ({sessions} sessions)"]
+    lines.append(f"Sessions folder: {plain(fleet.folder)}")
+    lines.append("")
+    lines.append(f"{'robot':<14}{'latest':<12}{'verdict':<22}{'RP':<14}{'Cpk':>5}  trend")
+    for line in fleet.robots:
+        entry = line.latest
+        moment = parse_time(entry.created)
+        when = moment.strftime("%Y-%m-%d") if isinstance(moment, datetime) else entry.created
+        rp = "-" if entry.rp is None else f"{format_spread(entry.rp, entry.resolution)} {line.unit}"
+        cpk = format_index(lowest_cpk(entry))
+        lines.append(
+            f"{plain(line.robot, limit=13):<14}{plain(when, limit=11):<12}"
+            f"{plain(entry.verdict, limit=21):<22}{rp:<14}{cpk:>5}  {line.trend}"
+        )
+    lines += [
+        "",
+        "Cpk: the latest session's lowest; trend: of Cpk over the robot's sessions (falling,",
+        "rising), else of the mean (drifting), else steady; - with fewer than three sessions.",
+        "station history ROBOT shows one robot's sessions and the dates of its trend.",
+    ]
+    if fleet.skipped:
+        lines += ["", f"Left out ({len(fleet.skipped)} files that could not be read):"]
+        lines += [f"  {plain(path.name)}: {plain(why)}" for path, why in fleet.skipped]
     return lines

@@ -46,8 +46,13 @@ def analyse_session(path: str | Path) -> AnalysedSession:
     Raises StationError when the file is not an intact session file; a session with nothing to
     analyse yet is returned with ``problem`` set instead.
     """
-    path = Path(path)
-    session = load_session(path, recover=False)
+    return analyse_loaded(load_session(Path(path), recover=False))
+
+
+def analyse_loaded(session: Session) -> AnalysedSession:
+    """:func:`analyse_session` of a session already loaded (a caller that reads its header
+    first, as the history does, loads the file once)."""
+    path = session.path
     source = session_source(session)
     method = session_method(session)
     try:

@@ -254,7 +254,7 @@ class SessionWriter:
     @property
     def next_cycle(self) -> int:
         """The number the next cycle gets."""
-        return max(self._replay.cycles, default=0) + 1
+        return self._replay.cycle_seqs.highest + 1
 
     @property
     def closed(self) -> bool:
@@ -368,8 +368,8 @@ class SessionWriter:
             ),
             errno.EIO: ("the disk reported an input/output error", "check the disk"),
         }.get(error.errno or 0, (f"writing failed ({error.strerror})", "fix the cause"))
-        cycles = self._replay.cycles
-        kept = f"cycle {max(cycles)}" if cycles else f"event {self._replay.last_seq}"
+        cycles = self._replay.cycle_seqs
+        kept = f"cycle {cycles.highest}" if cycles else f"event {self._replay.last_seq}"
         if not self._replay.header:
             with contextlib.suppress(OSError):
                 self.path.unlink()

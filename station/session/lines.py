@@ -71,6 +71,11 @@ def _reject_constant(name: str) -> Any:
     raise ValueError(f"{name} is not a number")
 
 
+# One decoder for every line: json.loads(text, parse_constant=...) builds a new one per call,
+# a tenth of the time of reading a long session.
+_DECODER = json.JSONDecoder(parse_constant=_reject_constant)
+
+
 def decode_line(line: bytes) -> dict[str, Any]:
     """The object on one line; ValueError saying why when the line is damaged."""
     if len(line) <= _HASH_SUFFIX_LENGTH or not line.endswith(b'"}'):
@@ -83,7 +88,7 @@ def decode_line(line: bytes) -> dict[str, Any]:
     if line_hash(body) != digest.decode("ascii"):
         raise ValueError("the line's content does not match its hash (the line was edited)")
     try:
-        record = json.loads(line.decode("utf-8"), parse_constant=_reject_constant)
+        record = _DECODER.decode(line.decode("utf-8"))
     except UnicodeDecodeError:
         raise ValueError("the line is not UTF-8 text") from None
     except RecursionError:

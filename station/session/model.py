@@ -34,14 +34,14 @@ import errno
 import fcntl
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, BinaryIO
 
 from station.errors import StationError
-from station.inputfiles import read_input_bytes
+from station.inputfiles import open_input_file, read_input_bytes
 from station.session.durable import fsync_folder, open_append_no_follow
 from station.session.lines import (
     SessionFileError,
@@ -275,19 +275,45 @@ def _split(data: bytes) -> _Split:
     lines = data.split(b"\n")
     tail = lines.pop()  # bytes after the last newline: b"" when the file ends cleanly
     if tail:
-        return _Split(lines, len(data) - len(tail), "the last line has no newline (cut short)")
-    if lines:
-        try:
-            decode_line(lines[-1])
-        except ValueError:
-            # A complete last line that does not decode is what a crash leaves when the file's
-            # length reached the disk before its data (zeros); an edited line that still decodes
-            # but fails its hash is not torn: decode_line tells the two apart.
-            last = lines[-1]
-            if not has_hash_suffix(last):
-                lines.pop()
-                return _Split(lines, len(data) - len(last) - 1, "the last line does not parse")
+        return _Split(lines, len(data) - len(tail), NO_NEWLINE)
+    if lines and _unparsable(lines[-1]):
+        last = lines.pop()
+        return _Split(lines, len(data) - len(last) - 1, DOES_NOT_PARSE)
     return _Split(lines, len(data), None)
+
+
+NO_NEWLINE = "the last line has no newline (cut short)"
+DOES_NOT_PARSE = "the last line does not parse"
+
+
+def _unparsable(last: bytes) -> bool:
+    """True when a complete last line is torn: it does not decode and has no well-formed hash.
+    A complete last line that does not decode is what a crash leaves when the file's length
+    reached the disk before its data (zeros); an edited line that still decodes but fails its
+    hash is not torn: decode_line tells the two apart."""
+    try:
+        decode_line(last)
+    except ValueError:
+        return not has_hash_suffix(last)
+    return False
+
+
+def _replay_line(replay: Replay, path: Path, number: int, line: bytes) -> dict[str, Any]:
+    """Check line ``number`` against what came before and add it to ``replay``; its record.
+    SessionFileError naming the line and the fault when it cannot come next (``replay`` is
+    then as it was)."""
+    try:
+        record = decode_line(line)
+        if record.get("prev") != replay.chain_hash:
+            raise ValueError(
+                "the hash chain is broken: 'prev' does not match the previous line "
+                "(a line before it was changed, removed or inserted)"
+            )
+        replay.check(record)
+    except ValueError as error:
+        raise SessionFileError(path, number, str(error)) from None
+    replay.apply(record, line)
+    return record
 
 
 def replay_bytes(data: bytes, path: Path, *, allow_torn: bool) -> tuple[Replay, int, _Split]:
@@ -310,22 +336,38 @@ def replay_bytes(data: bytes, path: Path, *, allow_torn: bool) -> tuple[Replay, 
         )
     replay = Replay()
     for number, line in enumerate(split.lines, start=1):
-        try:
-            record = decode_line(line)
-            if record.get("prev") != replay.chain_hash:
-                raise ValueError(
-                    "the hash chain is broken: 'prev' does not match the previous line "
-                    "(a line before it was changed, removed or inserted)"
-                )
-            replay.check(record)
-        except ValueError as error:
-            raise SessionFileError(path, number, str(error)) from None
-        replay.apply(record, line)
+        _replay_line(replay, path, number, line)
     # The torn tail is the first bad line only when every line before it holds: a newline
     # written into the last line leaves a bad complete line before the "torn" rest of it.
     if torn is not None:
         raise torn
     return replay, len(split.lines), split
+
+
+def replay_stream(
+    handle: BinaryIO, path: Path, replay: Replay
+) -> Iterator[tuple[int, dict[str, Any]]]:
+    """Check and replay a session file read from ``handle`` one line at a time into
+    ``replay``, yielding each line's number and record once it holds: the checks and
+    faults of :func:`replay_bytes` with ``allow_torn=False`` (a torn tail is the first bad
+    line), in memory that does not grow with the file beyond what ``replay`` keeps (a replay
+    that keeps only its checks holds runs of cycle numbers, not the cycles). SessionFileError
+    names the first bad line; on it, ``replay`` holds every line before."""
+    line = handle.readline()
+    # A first line that ends in a newline says, as the whole file would, that more follows.
+    if not looks_like_session(line):
+        raise not_a_session_error(path, empty=not line)
+    number = 0
+    while line:
+        following = handle.readline()
+        number += 1
+        if not line.endswith(b"\n"):
+            raise SessionFileError(path, number, f"torn: {NO_NEWLINE}")
+        line = line[:-1]
+        if not following and _unparsable(line):
+            raise SessionFileError(path, number, f"torn: {DOES_NOT_PARSE}")
+        yield number, _replay_line(replay, path, number, line)
+        line = following
 
 
 def load_session(path: str | os.PathLike[str], *, recover: bool = True) -> Session:
@@ -358,6 +400,14 @@ def read_session_bytes(path: Path) -> bytes:
     if not os.path.lexists(path):
         raise StationError(f"session file {path} does not exist")
     return read_input_bytes(path, "session file", SESSION_FILE_LIMIT)
+
+
+def open_session_file(path: Path) -> BinaryIO:
+    """The file open to read a line at a time, with the faults of :func:`read_session_bytes`
+    (a file past :data:`SESSION_FILE_LIMIT` fails when the read gets there)."""
+    if not os.path.lexists(path):
+        raise StationError(f"session file {path} does not exist")
+    return open_input_file(path, "session file", SESSION_FILE_LIMIT)
 
 
 def _handle_torn(path: Path, data: bytes, split: _Split, recover: bool) -> TornTail:

@@ -11,7 +11,9 @@ holds one check per event type. Like the model, it loads numpy only when arrays 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from array import array
+from bisect import bisect_right
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -147,6 +149,90 @@ def _optional_number(value: Any) -> float | None:
     return float(value) if _is_number(value) else None
 
 
+class CycleSeqs(Mapping[int, int]):
+    """The recorded cycle numbers, each with the seq of its reading event: what checking a
+    later reading or reject needs (a second reading of a cycle names the first one's seq).
+
+    Held as runs while the numbers ascend (the engine numbers cycles so, a resumed session
+    included): a run is cycles ``first``, ``first + 1`` ... whose seqs step by the same stride,
+    four 8-byte integers however long it is. A session's cycles make one run between two other
+    events (a reject, an alarm, a note), so ``station verify`` and a writer hold a session of
+    millions of readings in a few kilobytes. Only a number that comes out of order turns the
+    runs into a dict, a hundred bytes a cycle.
+    """
+
+    def __init__(self) -> None:
+        self._first = array("q")
+        self._seq = array("q")
+        self._stride = array("q")
+        self._count = array("q")
+        self._total = 0
+        self._unordered: dict[int, int] | None = None
+        self.highest = 0
+        """The largest cycle number recorded (0 before any)."""
+
+    def add(self, cycle: int, seq: int) -> None:
+        """Record that ``cycle``'s reading is event ``seq`` (a cycle not recorded yet)."""
+        self._total += 1
+        if self._unordered is not None:
+            self._unordered[cycle] = seq
+        elif not self._first or cycle > self.highest:
+            self._extend(cycle, seq)
+        else:
+            self._unordered = dict(self._pairs())
+            self._unordered[cycle] = seq
+            for column in (self._first, self._seq, self._stride, self._count):
+                del column[:]
+        self.highest = max(self.highest, cycle)
+
+    def _extend(self, cycle: int, seq: int) -> None:
+        if self._first:
+            first, start, count = self._first[-1], self._seq[-1], self._count[-1]
+            stride = seq - start if count == 1 else self._stride[-1]
+            if cycle == first + count and seq == start + count * stride:
+                self._stride[-1] = stride
+                self._count[-1] = count + 1
+                return
+        self._first.append(cycle)
+        self._seq.append(seq)
+        self._stride.append(0)
+        self._count.append(1)
+
+    def _pairs(self) -> Iterator[tuple[int, int]]:
+        for first, seq, stride, count in zip(
+            self._first, self._seq, self._stride, self._count, strict=True
+        ):
+            for step in range(count):
+                yield first + step, seq + step * stride
+
+    def _run(self, cycle: object) -> int | None:
+        if not isinstance(cycle, int) or not self._first or cycle > self.highest:
+            return None
+        at = bisect_right(self._first, cycle) - 1
+        return at if at >= 0 and cycle < self._first[at] + self._count[at] else None
+
+    def __getitem__(self, cycle: int) -> int:
+        if self._unordered is not None:
+            return self._unordered[cycle]
+        at = self._run(cycle)
+        if at is None:
+            raise KeyError(cycle)
+        return self._seq[at] + (cycle - self._first[at]) * self._stride[at]
+
+    def __contains__(self, cycle: object) -> bool:
+        if self._unordered is not None:
+            return cycle in self._unordered
+        return self._run(cycle) is not None
+
+    def __iter__(self) -> Iterator[int]:
+        if self._unordered is not None:
+            return iter(self._unordered)
+        return (cycle for cycle, _ in self._pairs())
+
+    def __len__(self) -> int:
+        return self._total
+
+
 @dataclass
 class Replay:
     """Accumulates a session's header and events, checking each one.
@@ -175,15 +261,23 @@ class Replay:
     """The last line's own ``hash`` field: the anchor printed on summaries and reports."""
     chain_hash: str | None = None
     """The sha256 of the last line's bytes: the next line's ``prev``."""
+    cycle_seqs: CycleSeqs = field(default_factory=CycleSeqs)
+    """The seq of each recorded cycle's reading, by cycle number: what checking a later reading
+    or reject needs (kept in every mode; :attr:`cycles` holds the cycles themselves)."""
+    alarm_seqs: set[int] = field(default_factory=set)
+    """The seqs of the alarm events: what checking an acknowledgement needs."""
     checks_only: bool = False
-    """A writer's replay: keep what checking the next event needs (the header, the cycle numbers,
-    rejects, alarms, inputs), not every event's record, its readings or its streamed points, so
-    a long session's memory stays small (the file keeps everything)."""
+    """A writer's (or ``station verify``'s) replay: keep what checking the next event needs
+    (the header, the cycle numbers, rejects, alarm seqs, inputs), not every event's record, its
+    cycles and readings, alarms or streamed points, so a long session's memory stays small (the
+    file keeps everything)."""
 
     def keep_checks_only(self) -> None:
         """Drop what only a reader of the whole session needs (see :attr:`checks_only`)."""
         self.checks_only = True
         self.events.clear()
+        self.cycles.clear()
+        self.alarms.clear()
         self.samples.clear()
         self.traces.clear()
         self.notes.clear()
@@ -224,12 +318,12 @@ class Replay:
             self.events.append(record)
         self.last_seq = record["seq"]
         kind = record["type"]
-        if kind == "reading" and self.checks_only:
-            # Checking later events needs the cycle's number, not its values.
-            self.cycles[record["cycle"]] = Cycle(
-                number=record["cycle"], seq=record["seq"], t=record["t"], step="", readings={}
-            )
-        elif kind == "reading":
+        if kind == "reading":
+            # Checking later events needs the cycle's number (and seq), not its values.
+            self.cycle_seqs.add(record["cycle"], record["seq"])
+        elif kind == "alarm":
+            self.alarm_seqs.add(record["seq"])
+        if kind == "reading" and not self.checks_only:
             readings = {
                 channel: ChannelReading(
                     value=float(spec["value"]),
@@ -256,7 +350,7 @@ class Replay:
             self.rejected[record["cycle"]] = record["reason"]
         elif kind == "note" and not self.checks_only:
             self.notes.append(record)
-        elif kind == "alarm":
+        elif kind == "alarm" and not self.checks_only:
             self.alarms.append(record)
         elif kind == "ack":
             self.acks.append(record)
@@ -395,8 +489,8 @@ def _check_zero(replay: Replay, record: Mapping[str, Any]) -> None:
 
 def _check_reading(replay: Replay, record: Mapping[str, Any]) -> None:
     cycle = _need_cycle(record)
-    if cycle in replay.cycles:
-        raise ValueError(f"cycle {cycle} is recorded twice (seq {replay.cycles[cycle].seq})")
+    if cycle in replay.cycle_seqs:
+        raise ValueError(f"cycle {cycle} is recorded twice (seq {replay.cycle_seqs[cycle]})")
     part = record.get("part")
     if part is not None and not (
         isinstance(part, int) and not isinstance(part, bool) and 1 <= part <= COUNT_LIMIT
@@ -416,7 +510,7 @@ def _check_reading(replay: Replay, record: Mapping[str, Any]) -> None:
 
 def _check_reject(replay: Replay, record: Mapping[str, Any]) -> None:
     cycle = _need_cycle(record)
-    if cycle not in replay.cycles:
+    if cycle not in replay.cycle_seqs:
         raise ValueError(f"a reject names cycle {cycle}, which was never recorded")
     _need_text(record, "reason")
 
@@ -484,7 +578,7 @@ def _check_ack(replay: Replay, record: Mapping[str, Any]) -> None:
     alarm = record.get("alarm")
     if not isinstance(alarm, int) or isinstance(alarm, bool):
         raise ValueError("an ack event needs 'alarm', the seq of the alarm it acknowledges")
-    if not any(event["seq"] == alarm for event in replay.alarms):
+    if alarm not in replay.alarm_seqs:
         raise ValueError(f"an ack names alarm {alarm}, which is not a recorded alarm event")
     cause = _need_text(record, "cause")
     for key in ("text", "action", "by"):

@@ -154,15 +154,20 @@ def _progress(session: Session) -> _Progress:
     }
 
 
+def session_paths(folder: str | os.PathLike[str]) -> list[Path]:
+    """The session files of ``folder``: every ``*.jsonl`` that is a file ([] when no folder)."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    return [path for path in folder.glob("*.jsonl") if path.is_file()]
+
+
 def list_sessions(folder: str | os.PathLike[str]) -> list[SessionSummary]:
     """Every ``*.jsonl`` in ``folder``, sorted by robot then creation time; [] when no folder.
 
     Files that do not load are listed with their error (sorted last), never raised.
     """
-    folder = Path(folder)
-    if not folder.is_dir():
-        return []
-    summaries = [summarise(path) for path in folder.glob("*.jsonl") if path.is_file()]
+    summaries = [summarise(path) for path in session_paths(folder)]
     return sorted(
         summaries,
         key=lambda s: (s.error is not None, s.robot.casefold(), s.created, s.path.name),

@@ -16,10 +16,11 @@ import os
 import textwrap
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 from station.plain import plain
-from station.session.lines import SessionFileError, decode_line, line_hash
-from station.session.model import read_session_bytes, replay_bytes
+from station.session.lines import SessionFileError
+from station.session.model import open_session_file, replay_stream
 from station.session.replay import Replay
 from station.session.signing import check_finish_signature, key_id, predates_signing
 from station.session.trust import find_trusted
@@ -89,87 +90,89 @@ def verify_session(
     let the file pass.
     """
     path = Path(path)
-    data = read_session_bytes(path)
-    result = _verify_chain(path, data)
-    if not result.ok:
-        return result
-    return _verify_end(result, data, anchor, allow_unsigned, trust_any)
-
-
-def _verify_chain(path: Path, data: bytes) -> VerifyResult:
-    try:
-        replay, lines, _ = replay_bytes(data, path, allow_torn=False)
-    except SessionFileError as error:
-        # Replay the intact lines before the bad one, for the counts and their last hash.
-        good = b"".join(line + b"\n" for line in data.split(b"\n")[: error.line - 1])
-        intact: Replay | None = None
+    wanted = None if anchor is None else anchor.strip().lower()
+    # Only what checking the next line needs is kept (runs of cycle numbers, not the cycles),
+    # and the file is read once, a line at a time: a session of hours verifies in a few
+    # megabytes. The anchor is looked for during the same pass.
+    replay = Replay()
+    replay.keep_checks_only()
+    lines, last, anchored_at = 0, None, None
+    with open_session_file(path) as handle:
         try:
-            if good:
-                intact, lines, _ = replay_bytes(good, path, allow_torn=False)
-            else:
-                lines = 0
-        except SessionFileError:
-            intact, lines = None, 0
-        return VerifyResult(
-            ok=False,
-            path=path,
-            lines=lines,
-            events=len(intact.events) if intact else 0,
-            cycles=len(intact.cycles) if intact else 0,
-            last_hash=(intact.last_hash or "") if intact else "",
-            first_bad_line=error.line,
-            message=f"NOT intact: line {error.line}: {error.fault}",
-        )
+            for lines, record in replay_stream(handle, path, replay):
+                last = record  # the finish, when it is the last line, carries the signature
+                # The line's own hash field, or the hash of its bytes (the next line's prev).
+                if anchored_at is None and wanted in (replay.last_hash, replay.chain_hash):
+                    anchored_at = lines
+        except SessionFileError as error:
+            # The counts and last hash are those of the intact lines before the bad one.
+            return _counts(
+                replay,
+                path,
+                ok=False,
+                lines=error.line - 1,
+                first_bad_line=error.line,
+                message=f"NOT intact: line {error.line}: {error.fault}",
+            )
     rejected = f", {len(replay.rejected)} rejected" if replay.rejected else ""
-    return VerifyResult(
+    result = _counts(
+        replay,
+        path,
         ok=True,
-        path=path,
         lines=lines,
-        events=len(replay.events),
-        cycles=len(replay.cycles),
-        last_hash=replay.last_hash or "",
         first_bad_line=None,
         message=(
-            f"intact: {lines} lines, {len(replay.events)} events, "
-            f"{len(replay.cycles)} cycles{rejected}, {replay.status}"
+            f"intact: {lines} lines, {replay.last_seq} events, "
+            f"{len(replay.cycle_seqs)} cycles{rejected}, {replay.status}"
         ),
+    )
+    assert last is not None  # a file without a complete line is a SessionFileError
+    return _verify_end(result, replay.header, last, wanted, anchored_at, allow_unsigned, trust_any)
+
+
+def _counts(replay: Replay, path: Path, **verdict: Any) -> VerifyResult:
+    """The result with the counts of the lines that hold (``replay``: the events are numbered
+    from 1 without a gap, so the last seq is their count)."""
+    return VerifyResult(
+        path=path,
+        events=replay.last_seq,
+        cycles=len(replay.cycle_seqs),
+        last_hash=replay.last_hash or "",
+        **verdict,
     )
 
 
 def _verify_end(
-    result: VerifyResult, data: bytes, anchor: str | None, allow_unsigned: bool, trust_any: bool
+    result: VerifyResult,
+    header: dict[str, Any],
+    last: dict[str, Any],
+    anchor: str | None,
+    anchored_at: int | None,
+    allow_unsigned: bool,
+    trust_any: bool,
 ) -> VerifyResult:
-    """The signature of a finished session, the trust in its key, the anchor, and what the
-    verdict cannot show."""
-    lines = data.split(b"\n")[:-1]
-    header = decode_line(lines[0])
-    last = decode_line(lines[-1])
+    """The signature of a finished session, the trust in its key, the anchor (found at line
+    ``anchored_at``, as its own hash or the hash of its bytes), and what the verdict cannot
+    show."""
+    lines = result.lines
     finished = last.get("type") == "finish"
     signed = _signature(header, last if finished else None, allow_unsigned, trust_any)
     if isinstance(signed, _Refusal):
         return replace(result, ok=False, first_bad_line=signed.line, message=signed.message)
     key, signed_by, remarks = signed
     if anchor is not None:
-        wanted = anchor.strip().lower()
-        if wanted != result.last_hash:
-            where = next(
-                (
-                    number
-                    for number, line in enumerate(lines, start=1)
-                    if decode_line(line).get("hash") == wanted or line_hash(line) == wanted
-                ),
-                None,
-            )
+        if anchor != result.last_hash:
+            where = anchored_at
             fault = (
                 f"the anchor is line {where}'s hash, not the last line's: "
-                f"{len(lines) - where} line(s) were added after the report"
+                f"{lines - where} line(s) were added after the report"
                 if where is not None
                 else "the anchor is not in the file: it was cut short or rewritten since the report"
             )
             return replace(
                 result,
                 ok=False,
-                first_bad_line=(where + 1) if where is not None else len(lines),
+                first_bad_line=(where + 1) if where is not None else lines,
                 message=f"NOT intact: {fault}",
                 key=key,
                 signed_by=signed_by,

@@ -200,3 +200,76 @@ def test_a_session_file_deleted_or_replaced_stops_the_writer(tmp_path: Path, how
     with pytest.raises(StationError, match=f"was {how} while the session was running"):
         writer.append("reading", **reading_fields(2))
     assert writer.closed
+
+
+# -- issue 23, item 2: verify streams the chain -------------------------------------------------
+
+
+def test_the_cycle_index_holds_numbers_and_seqs_in_runs_or_out_of_order():
+    from station.session.replay import CycleSeqs
+
+    index = CycleSeqs()
+    # 1-3 one run (seqs step by 2), 4 breaks the stride, 9 breaks the numbering.
+    for cycle, seq in ((1, 3), (2, 5), (3, 7), (4, 10), (5, 11), (9, 12)):
+        index.add(cycle, seq)
+    assert [index[c] for c in (1, 2, 3, 4, 5, 9)] == [3, 5, 7, 10, 11, 12]
+    assert 6 not in index and 10 not in index and 0 not in index and "2" not in index
+    assert list(index) == [1, 2, 3, 4, 5, 9] and len(index) == 6 and index.highest == 9
+    with pytest.raises(KeyError):
+        index[7]
+    index.add(7, 20)  # out of order: still found, by number
+    assert index[7] == 20 and index[3] == 7 and index.highest == 9 and len(index) == 7
+    assert sorted(index) == [1, 2, 3, 4, 5, 7, 9]
+
+
+def _extend_chain(path: Path, records: list[dict]) -> None:
+    """Append well-chained events after the file's last line, as the writer would (without an
+    fsync each: a long file in a moment)."""
+    data = path.read_bytes()
+    replay, _, _ = replay_bytes(data, path, allow_torn=False)
+    seq, prev = replay.last_seq, replay.chain_hash
+    with path.open("ab") as out:
+        for record in records:
+            seq += 1
+            line = encode_line({"seq": seq, "t": "2026-11-23T13:00:00.000000Z", **record}, prev)
+            out.write(line + b"\n")
+            prev = line_hash(line)
+
+
+def _long_session(folder: Path, cycles: int) -> Path:
+    path = write_session(folder, cycles=5, finish=False)
+    records: list[dict] = []
+    for cycle in range(6, cycles + 1):
+        records.append({"type": "reading", **reading_fields(cycle)})
+        if cycle % 100 == 0:
+            records.append({"type": "reject", "cycle": cycle, "reason": "bumped"})
+            records.append({"type": "alarm", "rule": "report-1", "channel": "x", "points": []})
+    _extend_chain(path, records)
+    return path
+
+
+def _verify_peak(path: Path) -> int:
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        result = verify_session(path)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert result.ok, result.message
+    return peak
+
+
+def test_verify_holds_a_line_at_a_time_not_the_file(tmp_path: Path) -> None:
+    """A session of hours is hundreds of megabytes of JSON: verify's memory must not grow with
+    the file (it held the bytes, every line and every event: ~9x the file)."""
+    short = _long_session(tmp_path / "short", 300)
+    long = _long_session(tmp_path / "long", 3000)
+    grown = _verify_peak(long) - _verify_peak(short)
+    more_bytes = long.stat().st_size - short.stat().st_size
+    assert more_bytes > 1_000_000
+    assert grown < more_bytes / 20, f"{grown} bytes more for {more_bytes} bytes more of file"
+    result = verify_session(long)
+    assert result.cycles == 3000 and result.events == load_session(long).last_seq
+    assert ", 31 rejected, running" in result.message  # 30 and the base session's one
