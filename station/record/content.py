@@ -4,9 +4,9 @@ html by :mod:`station.record.render`.
 Everything is formatted here, once, so the three formats cannot disagree: the robot, operator,
 procedure (id, version, sha256), date and duration, gauges, zeroes, limits, every reading with
 the rejects and their reasons, notes, alarms with their acknowledgements, the verdicts with the
-lower confidence bound of Cpk, hints, the procedure's own blocks, the anchor (the last line's
-hash) and the signature id, and the sign-off lines. Text from outside stays raw here; each
-format escapes it (see :mod:`station.record.text`).
+lower confidence bound of Cpk, each channel's measurement budget, hints, the procedure's own
+blocks, the anchor (the last line's hash) and the signature id, and the sign-off lines. Text
+from outside stays raw here; each format escapes it (see :mod:`station.record.text`).
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
 
+from station.analysis.report import budget_rows, budget_summary, decisions_text
 from station.analysis.rules import rule_name
 from station.record.source import AnalysedSession
 from station.text import (
@@ -121,6 +122,21 @@ class Verdict:
 
 
 @dataclass(frozen=True)
+class BudgetBlock:
+    """One channel's measurement budget: the table rows (input, u, |c|·u, dof, share), u_c and
+    U at k in a line, and the readings as the decision rule judged them with that U."""
+
+    name: str
+    rows: tuple[tuple[str, ...], ...]
+    summary: str
+    decisions: str
+
+
+BUDGET_HEADER = ("input", "u", "|c|·u", "dof", "share")
+"""The columns of a budget table."""
+
+
+@dataclass(frozen=True)
 class ReportContent:
     """The facts of one filed report, every value already formatted as text."""
 
@@ -165,6 +181,9 @@ class ReportContent:
     """Why there is no analysis ("" when there is one)."""
     torn: str
     """The torn tail's message ("" for an intact file)."""
+    budgets: tuple[BudgetBlock, ...] = ()
+    """Each judged channel's measurement budget (none when nothing of it is known)."""
+    budget_header: tuple[str, ...] = BUDGET_HEADER
     sign_off: tuple[str, ...] = SIGN_OFF
 
 
@@ -409,6 +428,26 @@ def _verdicts(analysed: AnalysedSession, resolution: float | None) -> tuple[Verd
     return tuple(verdicts)
 
 
+def _budgets(analysed: AnalysedSession, resolution: float | None) -> tuple[BudgetBlock, ...]:
+    if analysed.report is None or analysed.report.analysis is None:
+        return ()
+    unit = analysed.report.analysis.config.unit
+    blocks = []
+    for channel in analysed.report.analysis.channels.values():
+        if channel.budget is None:
+            continue
+        decisions = channel.reading_decisions
+        blocks.append(
+            BudgetBlock(
+                name=str(channel.name),
+                rows=tuple(budget_rows(channel.budget, resolution)),
+                summary=budget_summary(channel.budget, resolution, unit),
+                decisions="" if decisions is None else decisions_text(decisions, resolution, unit),
+            )
+        )
+    return tuple(blocks)
+
+
 def _figures(analysed: AnalysedSession, resolution: float | None) -> tuple[tuple[str, str], ...]:
     if analysed.report is None or analysed.report.analysis is None:
         return ()
@@ -495,6 +534,7 @@ def build_content(analysed: AnalysedSession) -> ReportContent:
         ),
         alarms=alarms,
         verdicts=_verdicts(analysed, resolution),
+        budgets=_budgets(analysed, resolution),
         figures=_figures(analysed, resolution),
         sections=report.sections if report is not None else (),
         hints=tuple(report.analysis.hints) if report is not None and report.analysis else (),

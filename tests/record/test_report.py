@@ -155,6 +155,9 @@ def facts(content) -> list[str]:
     for verdict in content.verdicts:
         said += [verdict.name, verdict.word, verdict.mean, verdict.sd, verdict.cpk]
         said += [verdict.cpk_lower, verdict.confidence]
+    for budget in content.budgets:
+        said += [cell for row in budget.rows for cell in row]
+        said += [budget.summary, budget.decisions]
     for row in content.readings:
         said += [*row.values, row.status]
     said += [f"Rejected cycle {cycle}: {reason}" for cycle, reason in content.rejected]
