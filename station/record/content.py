@@ -4,7 +4,7 @@ html by :mod:`station.record.render`.
 Everything is formatted here, once, so the three formats cannot disagree: the robot, operator,
 procedure (id, version, sha256), date and duration, gauges, zeroes, limits, every reading with
 the rejects and their reasons, notes, alarms with their acknowledgements, the verdicts with the
-lower confidence bound of Cpk, each channel's measurement budget, hints, the procedure's own
+one-sided confidence bounds of Cpk, each channel's measurement budget, hints, the procedure's own
 blocks, the anchor (the last line's hash) and the signature id, and the sign-off lines. Text
 from outside stays raw here; each format escapes it (see :mod:`station.record.text`).
 """
@@ -105,7 +105,8 @@ class AlarmLine:
 
 @dataclass(frozen=True)
 class Verdict:
-    """One judged channel: n, mean, σ, Cp, Cpk with its lower confidence bound, the word."""
+    """One judged channel: n, mean, σ, Cp, Cpk with its one-sided confidence bounds, the
+    word."""
 
     channel: str
     name: str
@@ -115,8 +116,10 @@ class Verdict:
     cp: str
     cpk: str
     cpk_lower: str
+    cpk_upper: str
+    """Bissell's one-sided upper bound on Cpk: with the lower one, what the verdict weighed."""
     confidence: str
-    """The one-sided confidence level of ``cpk_lower`` (``95%``)."""
+    """The one-sided confidence level of each of ``cpk_lower`` and ``cpk_upper`` (``95%``)."""
     word: str
     message: str
 
@@ -420,6 +423,7 @@ def _verdicts(analysed: AnalysedSession, resolution: float | None) -> tuple[Verd
                 cp=format_index(cap.cp),
                 cpk=judged_cpk(channel),
                 cpk_lower=format_index(cap.cpk_lower),
+                cpk_upper=format_index(cap.cpk_upper),
                 confidence=f"{cap.confidence:.0%}",
                 word=judged_label(channel),
                 message=str(cap.message or ""),

@@ -154,7 +154,9 @@ def facts(content) -> list[str]:
     ]
     for verdict in content.verdicts:
         said += [verdict.name, verdict.word, verdict.mean, verdict.sd, verdict.cpk]
-        said += [verdict.cpk_lower, verdict.confidence]
+        said += [verdict.cpk_lower, verdict.cpk_upper, verdict.confidence]
+        # Both bounds side by side, as the verdict weighed them.
+        said += [f"{verdict.cpk_lower} to {verdict.cpk_upper}"]
     for budget in content.budgets:
         said += [cell for row in budget.rows for cell in row]
         said += [budget.summary, budget.decisions]
@@ -339,3 +341,17 @@ def test_the_text_report_names_rules_in_words_with_acks_and_a_provisional_verdic
     assert "acknowledged: gauge; re-clamped the x indicator" in text
     assert "PROVISIONAL: 9 of 25" in text
     assert " CAPABLE" not in text.replace("NOT CAPABLE", "")
+
+
+def test_the_filed_report_shows_cpks_upper_bound_beside_the_lower(sessions):
+    """INCONCLUSIVE rests on both one-sided bounds: the filed report shows both, and says they
+    are Bissell's and one-sided (issue 20)."""
+    path = write_repeatability(sessions, robot="bounds", noise={"x": 0.0003})
+    analysis = analyse_session(path).report.analysis
+    cap = analysis.channels["x"].capability
+    assert cap.cpk_upper is not None and cap.cpk_lower is not None
+    pair = f"{cap.cpk_lower:.2f} to {cap.cpk_upper:.2f}"
+    assert f"Cpk bounds {pair} (one-sided, 95% each, Bissell)" in render_report(path, "txt")
+    assert f"{pair} (95%)" in render_report(path, "md")
+    html = render_report(path, "html")
+    assert "Cpk bounds (one-sided each, Bissell)" in html and f"{pair} (95%)" in html
