@@ -16,6 +16,7 @@ labels the readings are cycles 1, 2, 3 ... in order.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -63,6 +64,7 @@ from station.analysis.uncertainty import (
     judge_readings,
 )
 from station.analysis.verdict import DEFAULT_MIN_N, NOT_CAPABLE, Verdict, judge_verdict
+from station.analysis.zeros import ZeroDraw, zeros_variance
 from station.errors import StationError
 
 NO_LIMITS_MESSAGE = "no specification limits: give limits for this channel"
@@ -100,6 +102,10 @@ class AnalysisConfig:
     zero_uncertainty: Mapping[str, float] = field(default_factory=dict)
     """The standard uncertainty of the zero in force per channel (from the session's zero
     events): an offset from nominal within what it explains is said to be the zero's."""
+    zero_draws: Mapping[str, tuple[ZeroDraw, ...]] = field(default_factory=dict)
+    """Per channel, the zeros its readings were taken under (their count of readings and
+    within-rest spread): each is one rest of the robot, so the mean's offset carries its
+    rest-to-rest uncertainty (:mod:`station.analysis.zeros`). None for a channel not zeroed."""
     decision_rule: str = Rule.GUARDED.value
     """How a reading is judged against its limits with the budget's U: ``guarded``
     acceptance (ISO 14253-1, the default) or ``simple`` (no guard band), from the header."""
@@ -555,6 +561,18 @@ def spatial_of(channels: Mapping[str, np.ndarray], config: AnalysisConfig) -> Sp
     return spatial_figures(x, y, z, nominal=nominal)
 
 
+def zero_sd_of(channel: ChannelAnalysis, config: AnalysisConfig) -> float | None:
+    """The standard uncertainty the zero puts on ``channel``'s mean: √Var(z) from its zero
+    draws and the session's own spread (rest to rest, :func:`zeros_variance`); where the
+    session records no draws, the zero's recorded within-rest uncertainty; None when the
+    channel was not zeroed by the session."""
+    draws = config.zero_draws.get(channel.name)
+    sd = channel.descriptive.sd
+    if draws and sd is not None:
+        return math.sqrt(zeros_variance(sd, draws))
+    return config.zero_uncertainty.get(channel.name)
+
+
 def hints_of(channels: Sequence[ChannelAnalysis], config: AnalysisConfig) -> tuple[str, ...]:
     """Every channel's hints, in channel order."""
     hints: list[str] = []
@@ -569,7 +587,7 @@ def hints_of(channels: Sequence[ChannelAnalysis], config: AnalysisConfig) -> tup
                 nominal=channel.nominal,
                 resolution=config.resolution,
                 unit=config.unit,
-                zero_uncertainty=config.zero_uncertainty.get(channel.name),
+                zero_sd=zero_sd_of(channel, config),
             )
         )
         hints.extend(diagnostic_hints(channel))

@@ -134,13 +134,28 @@ def zero_draws(events: Iterable[Mapping[str, Any]]) -> dict[str, tuple[ZeroDraw,
     }
 
 
+def _draws_in_force(zeroes: Iterable[Mapping[str, Any]]) -> dict[str, tuple[ZeroDraw, ...]]:
+    """Per channel, the zero in force (its last ``zero`` event) as the one draw its readings
+    carry: what the zero events alone can say, without the readings that weight each zero."""
+    found: dict[str, tuple[ZeroDraw, ...]] = {}
+    for event in zeroes:
+        for channel, spec in dict(event.get("channels") or {}).items():
+            draw = _zero_draw(spec)
+            found[str(channel)] = (ZeroDraw(draw.readings, draw.within_sd, 1),)
+    return found
+
+
 def analysis_config(
-    header: Mapping[str, Any], zeroes: Iterable[Mapping[str, Any]] = ()
+    header: Mapping[str, Any],
+    zeroes: Iterable[Mapping[str, Any]] = (),
+    events: Iterable[Mapping[str, Any]] | None = None,
 ) -> AnalysisConfig:
     """The :class:`AnalysisConfig` a session header implies: its limits, resolution, unit, rule
     set and threshold (single readings, subgroup 1), the gauges' register snapshot (for the
     measurement budget); ``zeroes`` (the session's ``zero`` events) give each channel's zero
-    uncertainty."""
+    uncertainty; ``events`` (all of them, when known) weight each zero by the readings taken
+    under it, else the zero in force is the one draw (the running engine's view)."""
+    zeroes = list(zeroes)
     resolution = header.get("resolution")
     # Streamed strokes are judged one straightness per stroke: their verdict is final from the
     # strokes the procedure's stroke step asks for, not from its count of cycles.
@@ -156,6 +171,7 @@ def analysis_config(
         freeze_after=freeze if isinstance(freeze, int) and freeze >= 2 else DEFAULT_FREEZE_AFTER,
         baseline=baseline_from_json(header.get("baseline")),
         zero_uncertainty=zero_uncertainties(zeroes),
+        zero_draws=_draws_in_force(zeroes) if events is None else zero_draws(events),
         gauges=gauge_records(header),
         decision_rule=str(header.get("decision_rule") or "guarded"),
     )
