@@ -169,8 +169,8 @@ def budget_rows(result: BudgetResult, resolution: float | None) -> list[tuple[st
     return [
         (
             line.name,
-            format_spread(line.u, _finer(resolution)),
-            format_spread(line.ui, _finer(resolution)),
+            format_spread(line.u, resolution),
+            format_spread(line.ui, resolution),
             "inf" if math.isinf(line.dof) else f"{line.dof:.0f}",
             f"{100 * line.share:.1f}%",
         )
@@ -178,16 +178,11 @@ def budget_rows(result: BudgetResult, resolution: float | None) -> list[tuple[st
     ]
 
 
-def _finer(resolution: float | None) -> float | None:
-    # A standard uncertainty is a fraction of a step: shown one more decimal finer than a
-    # reading, so r/√12 of a 0.0001 in step reads 0.000029, not 0.00003.
-    return None if resolution is None else resolution / 10
-
-
 def budget_summary(result: BudgetResult, resolution: float | None, unit: str = "") -> str:
-    """``u_c 0.000042 in, U = 0.000083 in at k = 2 (nu_eff inf)``."""
+    """``u_c 0.00004 in, U = 0.00008 in at k = 2 (nu_eff inf)``: one decimal beyond the
+    gauge step like every figure (a u of r/√12 reads 0.00003 at a 0.0001 in step)."""
     unit_text = f" {unit}" if unit else ""
-    step = _finer(resolution)
+    step = resolution
     nu = "inf" if math.isinf(result.nu_eff) else f"{result.nu_eff:.1f}"
     return (
         f"u_c {format_spread(result.u_c, step)}{unit_text}, "
@@ -201,10 +196,10 @@ def budget_line(
     resolution: float | None,
     unit: str = "",
 ) -> str:
-    """The budget in one short line, for a screen: ``measurement U 0.000058 in, k = 2: 29 PASS
+    """The budget in one short line, for a screen: ``measurement U 0.00006 in, k = 2: 29 PASS
     0 FAIL 1 INDETERMINATE`` (the rule named only when it is not the default guarded one)."""
     unit_text = f" {unit}" if unit else ""
-    expanded = format_spread(result.U, _finer(resolution))
+    expanded = format_spread(result.U, resolution)
     text = f"measurement U {expanded}{unit_text}, k = {result.k:g}"
     if decisions is not None:
         text += (
@@ -222,7 +217,7 @@ def decisions_text(decisions: ReadingDecisions, resolution: float | None, unit: 
     if decisions.rule is Rule.GUARDED:
         rule = (
             f"guarded acceptance (ISO 14253-1: limits shrunk by U = "
-            f"{format_spread(decisions.U, _finer(resolution))}{unit_text} to pass, widened by U "
+            f"{format_spread(decisions.U, resolution)}{unit_text} to pass, widened by U "
             "to fail)"
         )
     else:
