@@ -78,6 +78,7 @@ def channel_to_json(channel: ChannelAnalysis) -> dict[str, Any]:
             "percentile": _percentile_json(channel.percentile),
         },
         "out_of_spec": _out_of_spec_json(channel),
+        "budget": _budget_json(channel),
         "normality": _normality_json(channel.normality),
         "autocorrelation": _autocorrelation_json(channel.autocorrelation),
         "drift": _drift_json(channel.drift),
@@ -184,6 +185,18 @@ def _percentile_json(result: PercentileCapability | None) -> dict[str, Any] | No
         "ppl": json_number(result.ppl),
         "ppk": json_number(result.ppk),
         "capable": result.capable,
+    }
+
+
+def _budget_json(channel: ChannelAnalysis) -> dict[str, Any] | None:
+    """The channel's measurement budget (u_c, U, k, contributions) and, with limits, its
+    readings judged by the decision rule with that U (null when no budget is known)."""
+    if channel.budget is None:
+        return None
+    decisions = channel.reading_decisions
+    return {
+        **channel.budget.as_json(),
+        "readings": None if decisions is None else decisions.as_json(),
     }
 
 

@@ -10,7 +10,10 @@ verdicts: the verdict is the capability index; these point the technician at a l
   attributed to the linearization of the inverse kinematics software and/or the effect of the
   ambient temperature". With 25–30 noisy readings the average never equals the nominal exactly,
   so the hint fires only when the offset is statistically clear: |X̄ − nominal| greater than the
-  two-sided 95 % t-interval half-width t(0.975, n−1)·s/√n.
+  two-sided 95 % t-interval half-width t(0.975, n−1)·s/√n. A session's readings are taken
+  from a zero, which is one rest of the robot: its rest-to-rest uncertainty √Var(z)
+  (:mod:`station.analysis.zeros`, about s for a still dial indicator) is combined with that
+  half-width, and an offset within both is said to be the zero's, not the inverse kinematics'.
 * Shift: Cp ≥ threshold but Cpk < threshold means the spread fits the tolerance but the process
   sits off centre (the report's Cpk1/Cpk2 "shift off the nominal value").
 * Rule alarms: a pattern on the control chart; look at the cycles it names.
@@ -89,14 +92,16 @@ ZERO_COVERAGE = 2.0
 """Coverage factor on the zero's standard uncertainty (about 95 %)."""
 
 
-def zero_explains(descriptive: Descriptive, nominal: float, zero_uncertainty: float) -> bool:
+def zero_explains(descriptive: Descriptive, nominal: float, zero_sd: float) -> bool:
     """True when the mean's offset from nominal lies within what the readings' own scatter and
-    the zero's uncertainty together explain: every reading was shifted by the zero taken, so
-    an offset of the zero's size is no evidence against the robot."""
+    the zero's uncertainty ``zero_sd`` together explain: every reading was shifted by the zero
+    taken, so an offset of the zero's size is no evidence against the robot. ``zero_sd`` is
+    √Var(z) of :mod:`station.analysis.zeros`: a zero is one rest of the robot, so it carries
+    the robot's rest-to-rest repeatability, not only the gauge's noise while it was taken."""
     if descriptive.mean is None:
         return False
     offset = abs(descriptive.mean - nominal)
-    combined = math.hypot(_mean_half_width(descriptive), ZERO_COVERAGE * zero_uncertainty)
+    combined = math.hypot(_mean_half_width(descriptive), ZERO_COVERAGE * zero_sd)
     return offset <= combined
 
 
@@ -110,11 +115,12 @@ def channel_hints(
     nominal: float,
     resolution: float | None,
     unit: str = "",
-    zero_uncertainty: float | None = None,
+    zero_sd: float | None = None,
 ) -> list[str]:
     """The hints for one channel, each a sentence naming the channel and the figure.
-    ``zero_uncertainty``: the standard uncertainty of the zero the readings are taken from (an
-    offset it explains is said to be the zero's, not the robot's)."""
+    ``zero_sd``: the standard uncertainty the zero the readings are taken from puts on their
+    mean (:func:`station.analysis.summary.zero_sd_of`: rest to rest); an offset it explains is
+    said to be the zero's, not the robot's."""
     hints: list[str] = []
     skew = descriptive.skewness
     if skew is not None and abs(skew) >= SKEW_HINT:
@@ -133,20 +139,20 @@ def channel_hints(
             else f"off the nominal {_figure(nominal, resolution, unit)}"
         )
         zero = (
-            f"±{format_figure(ZERO_COVERAGE * zero_uncertainty, resolution, signed=False)} "
-            f"{unit}".rstrip()
-            if zero_uncertainty is not None
+            f"±{format_figure(ZERO_COVERAGE * zero_sd, resolution, signed=False)} {unit}".rstrip()
+            if zero_sd is not None
             else ""
         )
-        if zero_uncertainty is not None and zero_explains(descriptive, nominal, zero_uncertainty):
+        if zero_sd is not None and zero_explains(descriptive, nominal, zero_sd):
             hints.append(
                 f"{name}: the average is {_figure(offset, resolution, unit)} {where}, within "
-                f"what the zero's own uncertainty ({zero}) explains: every reading carries the "
-                "zero taken, so zero again from more readings (the robot still at the fixture) "
-                "before blaming the robot."
+                f"what the zero's uncertainty ({zero}, rest to rest) explains: every reading "
+                "carries the zero taken, and a zero is one rest of the robot, so this offset "
+                "says nothing of the robot; to measure one, zero on a master or as the mean of "
+                "several returns to the pose."
             )
         else:
-            beyond = f", beyond the zero's own uncertainty ({zero})" if zero else ""
+            beyond = f", beyond the zero's uncertainty ({zero}, rest to rest)" if zero else ""
             hints.append(
                 f"{name}: the average is {_figure(offset, resolution, unit)} {where}, "
                 f"more than chance explains with {descriptive.n} readings{beyond}; the report "

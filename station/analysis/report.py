@@ -24,6 +24,7 @@ from station.analysis.diagnostics import PERCENTILE_MIN_N, p_phrase
 from station.analysis.rules import number_list, rule_name
 from station.analysis.spatial import Spatial
 from station.analysis.summary import Analysis, AnalysisConfig, ChannelAnalysis
+from station.analysis.uncertainty import BudgetResult, ReadingDecisions, Rule
 from station.analysis.verdict import Verdict, confidence_text, judge_verdict
 from station.text import format_figure, format_spread, judged_count
 
@@ -159,6 +160,106 @@ def _capability_lines(
     if cap.capable is not None and cap.message:
         line += f"; {cap.message}"
     lines.extend(_wrap(line, width))
+    return lines
+
+
+def budget_rows(result: BudgetResult, resolution: float | None) -> list[tuple[str, ...]]:
+    """The budget's table rows, figures in the one number format: input, u, |c|·u, dof,
+    share of u_c². The filed report and the text report both lay these out."""
+    return [
+        (
+            line.name,
+            format_spread(line.u, resolution),
+            format_spread(line.ui, resolution),
+            "inf" if math.isinf(line.dof) else f"{line.dof:.0f}",
+            f"{100 * line.share:.1f}%",
+        )
+        for line in result.lines
+    ]
+
+
+def budget_summary(result: BudgetResult, resolution: float | None, unit: str = "") -> str:
+    """``u_c 0.00004 in, U = 0.00008 in at k = 2 (nu_eff inf)``: one decimal beyond the
+    gauge step like every figure (a u of r/√12 reads 0.00003 at a 0.0001 in step)."""
+    unit_text = f" {unit}" if unit else ""
+    step = resolution
+    nu = "inf" if math.isinf(result.nu_eff) else f"{result.nu_eff:.1f}"
+    return (
+        f"u_c {format_spread(result.u_c, step)}{unit_text}, "
+        f"U = {format_spread(result.U, step)}{unit_text} at k = {result.k:g} (nu_eff {nu})"
+    )
+
+
+def budget_line(
+    result: BudgetResult,
+    decisions: ReadingDecisions | None,
+    resolution: float | None,
+    unit: str = "",
+) -> str:
+    """The budget in one short line, for a screen: ``measurement U 0.00006 in, k = 2: 29 PASS
+    0 FAIL 1 INDETERMINATE`` (the rule named only when it is not the default guarded one)."""
+    unit_text = f" {unit}" if unit else ""
+    expanded = format_spread(result.U, resolution)
+    text = f"measurement U {expanded}{unit_text}, k = {result.k:g}"
+    if decisions is not None:
+        text += (
+            f": {decisions.passed} PASS {decisions.failed} FAIL "
+            f"{decisions.indeterminate} INDETERMINATE"
+        )
+        if decisions.rule is not Rule.GUARDED:
+            text += f" ({decisions.rule.value})"
+    return text
+
+
+def decisions_text(decisions: ReadingDecisions, resolution: float | None, unit: str = "") -> str:
+    """The readings as the decision rule judged them with the budget's U, in a sentence."""
+    unit_text = f" {unit}" if unit else ""
+    if decisions.rule is Rule.GUARDED:
+        rule = (
+            f"guarded acceptance (ISO 14253-1: limits shrunk by U = "
+            f"{format_spread(decisions.U, resolution)}{unit_text} to pass, widened by U "
+            "to fail)"
+        )
+    else:
+        rule = "simple acceptance (no guard band)"
+    text = (
+        f"Readings judged by {rule}: {decisions.passed} PASS, {decisions.failed} FAIL, "
+        f"{decisions.indeterminate} INDETERMINATE"
+    )
+    if decisions.cycles_failed:
+        text += f"; FAIL at cycles {number_list(decisions.cycles_failed)}"
+    if decisions.cycles_indeterminate:
+        text += (
+            f"; INDETERMINATE (neither in nor out is proven) at cycles "
+            f"{number_list(decisions.cycles_indeterminate)}"
+        )
+    if decisions.zone is None:
+        text += "; the guard bands leave no acceptance zone: no reading can pass with this U"
+    return text + "."
+
+
+def format_budget(
+    channel: ChannelAnalysis, resolution: float | None, unit: str = "", width: int = 80
+) -> list[str]:
+    """The channel's MEASUREMENT BUDGET block: the table, u_c and U at k, and the readings'
+    decisions with that U; a line saying no budget is known when none is."""
+    result = channel.budget
+    if result is None:
+        return _wrap(
+            "MEASUREMENT BUDGET: none known (no gauge step, certificate, Type-1 check or zero "
+            "recorded): the decisions below carry no measurement uncertainty.",
+            width,
+        )
+    lines = ["MEASUREMENT BUDGET (GUM; one reading)"]
+    lines += [
+        f"  {row}"
+        for row in _table(
+            ("input", "u", "|c|*u", "dof", "share"), budget_rows(result, resolution), width - 2
+        )
+    ]
+    lines += _wrap(budget_summary(result, resolution, unit), width, "  ")
+    if channel.reading_decisions is not None:
+        lines += _wrap(decisions_text(channel.reading_decisions, resolution, unit), width, "  ")
     return lines
 
 
@@ -406,6 +507,8 @@ def format_judgement(
                 lines += _wrap(f"{rule_name(alarm.rule)} [live]: {alarm.text}", width, "  ")
         else:
             lines.append("LIVE ALARMS (against the frozen limits): none")
+    lines.append("")
+    lines += format_budget(channel, resolution, config.unit, width)
     lines.append("")
     lines += _capability_lines(cap, chart.type, resolution, width, channel.verdict)
     diagnostics = format_diagnostics(channel, resolution, width)

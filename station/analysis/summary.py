@@ -16,6 +16,7 @@ labels the readings are cycles 1, 2, 3 ... in order.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -52,7 +53,18 @@ from station.analysis.phases import (
 )
 from station.analysis.rules import RULE_SETS, Alarm, PointCycles, check_rules
 from station.analysis.spatial import AXES, Spatial, find_axes, spatial_figures
+from station.analysis.uncertainty import (
+    Budget,
+    BudgetResult,
+    GaugeRecord,
+    ReadingDecisions,
+    Rule,
+    channel_budget,
+    evaluate,
+    judge_readings,
+)
 from station.analysis.verdict import DEFAULT_MIN_N, NOT_CAPABLE, Verdict, judge_verdict
+from station.analysis.zeros import ZeroDraw, zeros_variance
 from station.errors import StationError
 
 NO_LIMITS_MESSAGE = "no specification limits: give limits for this channel"
@@ -90,6 +102,16 @@ class AnalysisConfig:
     zero_uncertainty: Mapping[str, float] = field(default_factory=dict)
     """The standard uncertainty of the zero in force per channel (from the session's zero
     events): an offset from nominal within what it explains is said to be the zero's."""
+    zero_draws: Mapping[str, tuple[ZeroDraw, ...]] = field(default_factory=dict)
+    """Per channel, the zeros its readings were taken under (their count of readings and
+    within-rest spread): each is one rest of the robot, so the mean's offset carries its
+    rest-to-rest uncertainty (:mod:`station.analysis.zeros`). None for a channel not zeroed."""
+    decision_rule: str = Rule.GUARDED.value
+    """How a reading is judged against its limits with the budget's U: ``guarded``
+    acceptance (ISO 14253-1, the default) or ``simple`` (no guard band), from the header."""
+    gauges: Mapping[str, GaugeRecord] = field(default_factory=dict)
+    """Per channel, what the gauge register said of its gauge (certificate, Type-1
+    repeatability): lines of the channel's measurement budget."""
 
     def __post_init__(self) -> None:
         if self.resolution is not None and not self.resolution > 0:
@@ -108,6 +130,10 @@ class AnalysisConfig:
             raise StationError(
                 f"the live limits need at least 2 points to freeze, not {self.freeze_after}."
             )
+        if self.decision_rule not in {rule.value for rule in Rule}:
+            raise StationError(
+                f"unknown decision rule {self.decision_rule!r}; choose guarded or simple."
+            )
         if not self.threshold > 0:
             raise StationError(
                 f"the capability threshold must be a positive number, not {self.threshold!r}."
@@ -116,6 +142,17 @@ class AnalysisConfig:
     def limits_for(self, channel: str) -> SpecLimits | None:
         """The specification limits that apply to ``channel`` (None when there are none)."""
         return self.limits.get(channel, self.default_limits)
+
+    def budget_for(self, channel: str) -> Budget | None:
+        """The measurement budget of one reading of ``channel`` (:func:`channel_budget`): the
+        gauge step, the gauge's certificate and Type-1 repeatability, the zero's uncertainty;
+        None when nothing of it is known."""
+        return channel_budget(
+            self.resolution,
+            self.gauges.get(channel),
+            self.zero_uncertainty.get(channel),
+            self.unit,
+        )
 
     def nominal_for(self, channel: str) -> float:
         """The nominal of ``channel``: its limits' nominal, else ``nominal``, else 0."""
@@ -154,10 +191,32 @@ class ChannelAnalysis:
     resolution: float | None = None
     """The gauge step the readings were judged at (the normality test's ties, the drift's
     figures)."""
+    budget: BudgetResult | None = None
+    """The evaluated measurement budget of one reading (U at k = 2): what every decision of a
+    reading against the limits takes, and what every output shows (None: nothing known)."""
+    decision_rule: str = Rule.GUARDED.value
+    """The rule a reading is judged against the limits by (``guarded`` or ``simple``)."""
 
     # The checks of what the capability assumes are worked out on first use: tens of ms a
     # channel (a test of normality sorts the readings), too much for every redraw of a live
     # snapshot that does not show them.
+
+    @cached_property
+    def reading_decisions(self) -> ReadingDecisions | None:
+        """Every reading judged against the limits with :attr:`budget`'s U by the config's
+        decision rule (guarded acceptance unless the header says ``simple``); None without
+        limits or a budget."""
+        limits, budget = self.limits, self.budget
+        if limits is None or budget is None or (limits.lsl is None and limits.usl is None):
+            return None
+        return judge_readings(
+            self.readings.array,
+            self.cycles.array,
+            limits.lsl,
+            limits.usl,
+            budget,
+            self.decision_rule,
+        )
 
     @cached_property
     def discrimination(self) -> Discrimination | None:
@@ -481,6 +540,8 @@ def analyze_channel(
         phase_rules=(config.rule_set, config.unit, config.subgroup, config.resolution),
         times=clock or NO_TIMES,
         resolution=config.resolution,
+        budget=None if (budget := config.budget_for(name)) is None else evaluate(budget),
+        decision_rule=config.decision_rule,
     )
 
 
@@ -500,6 +561,18 @@ def spatial_of(channels: Mapping[str, np.ndarray], config: AnalysisConfig) -> Sp
     return spatial_figures(x, y, z, nominal=nominal)
 
 
+def zero_sd_of(channel: ChannelAnalysis, config: AnalysisConfig) -> float | None:
+    """The standard uncertainty the zero puts on ``channel``'s mean: √Var(z) from its zero
+    draws and the session's own spread (rest to rest, :func:`zeros_variance`); where the
+    session records no draws, the zero's recorded within-rest uncertainty; None when the
+    channel was not zeroed by the session."""
+    draws = config.zero_draws.get(channel.name)
+    sd = channel.descriptive.sd
+    if draws and sd is not None:
+        return math.sqrt(zeros_variance(sd, draws))
+    return config.zero_uncertainty.get(channel.name)
+
+
 def hints_of(channels: Sequence[ChannelAnalysis], config: AnalysisConfig) -> tuple[str, ...]:
     """Every channel's hints, in channel order."""
     hints: list[str] = []
@@ -514,7 +587,7 @@ def hints_of(channels: Sequence[ChannelAnalysis], config: AnalysisConfig) -> tup
                 nominal=channel.nominal,
                 resolution=config.resolution,
                 unit=config.unit,
-                zero_uncertainty=config.zero_uncertainty.get(channel.name),
+                zero_sd=zero_sd_of(channel, config),
             )
         )
         hints.extend(diagnostic_hints(channel))

@@ -35,6 +35,9 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from enum import StrEnum
 from statistics import NormalDist
+from typing import Any
+
+import numpy as np
 
 from station.errors import StationError
 
@@ -264,6 +267,94 @@ class BudgetResult:
     lines: tuple[Line, ...]
     unit: str = ""
 
+    def as_json(self) -> dict[str, Any]:
+        """``{"u_c", "nu_eff", "k", "U", "confidence", "unit", "contributions": [{"name", "u",
+        "sensitivity", "ui", "dof", "share"}]}``: ∞ degrees of freedom as null (JSON has no
+        infinity). ``station budget --json`` and ``analyze --json`` both print this."""
+        return {
+            "u_c": self.u_c,
+            "nu_eff": _finite(self.nu_eff),
+            "k": self.k,
+            "U": self.U,
+            "confidence": self.confidence,
+            "unit": self.unit,
+            "contributions": [
+                {
+                    "name": line.name,
+                    "u": line.u,
+                    "sensitivity": line.sensitivity,
+                    "ui": line.ui,
+                    "dof": _finite(line.dof),
+                    "share": line.share,
+                }
+                for line in self.lines
+            ],
+        }
+
+
+def _finite(value: float) -> float | None:
+    return value if math.isfinite(value) else None
+
+
+@dataclass(frozen=True)
+class GaugeRecord:
+    """What the gauge register said of a channel's gauge when the session began, for its
+    budget: the calibration certificate's expanded uncertainty ``certificate_U`` at
+    ``certificate_k`` (None: no certificate recorded), and the latest Type-1 check's sample SD
+    ``repeatability_sd`` of ``repeatability_n`` readings (None: no check recorded)."""
+
+    gauge: str = ""
+    certificate_U: float | None = None
+    certificate_k: float | None = None
+    repeatability_sd: float | None = None
+    repeatability_n: int | None = None
+
+
+def channel_budget(
+    step: float | None,
+    gauge: GaugeRecord | None = None,
+    zero_uncertainty: float | None = None,
+    unit: str = "",
+) -> Budget | None:
+    """The measurement budget of one reading of a dial-indicator channel, from what the session
+    records: the gauge ``step`` (r/2 rectangular), the gauge's certificate (U/k), its repeatability
+    from the latest Type-1 check (s on n − 1), and the zero's own standard uncertainty (its
+    readings' standard error with their rounding, as the zero event records it). None when
+    the session records none of them.
+
+    The step and the Type-1 s are both kept although s already holds some rounding: GUM F.2.2.1
+    allows either; keeping both can only overstate u_c, never hide the step. The zero's
+    rest-to-rest draw (:mod:`station.analysis.zeros`) is not a line here: it moves the mean of
+    a session, not the measurement of one reading against the zero taken.
+    """
+    lines: list[Contribution] = []
+    if step is not None and step > 0:
+        lines.append(resolution(step, "gauge step (r/2 rectangular)"))
+    if gauge is not None:
+        if gauge.certificate_U is not None and gauge.certificate_k is not None:
+            lines.append(
+                from_expanded(
+                    f"certificate (U at k = {gauge.certificate_k:g})",
+                    gauge.certificate_U,
+                    gauge.certificate_k,
+                )
+            )
+        if (
+            gauge.repeatability_sd is not None
+            and gauge.repeatability_n is not None
+            and gauge.repeatability_n >= 2
+        ):
+            lines.append(
+                repeatability(
+                    gauge.repeatability_sd,
+                    gauge.repeatability_n,
+                    f"repeatability (Type-1, n = {gauge.repeatability_n})",
+                )
+            )
+    if zero_uncertainty is not None and math.isfinite(zero_uncertainty) and zero_uncertainty >= 0:
+        lines.append(Contribution("zero", zero_uncertainty))
+    return Budget(tuple(lines), unit) if lines else None
+
 
 def evaluate(
     budget: Budget | Iterable[Contribution],
@@ -424,3 +515,72 @@ def p_conformance(value: float, lsl: float | None, usl: float | None, u_c: float
     upper = 1.0 if usl is None else normal.cdf(usl)
     lower = 0.0 if lsl is None else normal.cdf(lsl)
     return max(0.0, upper - lower)
+
+
+@dataclass(frozen=True)
+class ReadingDecisions:
+    """Every reading of a channel judged against its limits by ``rule`` with one evaluated
+    budget (:func:`judge_readings`): how many PASS, FAIL and INDETERMINATE, the cycles of the
+    last two, and the ``zone`` the rule accepts (None when the guard bands leave nothing)."""
+
+    rule: Rule
+    U: float
+    passed: int
+    failed: int
+    indeterminate: int
+    cycles_failed: tuple[int, ...]
+    cycles_indeterminate: tuple[int, ...]
+    zone: tuple[float | None, float | None] | None
+
+    def as_json(self) -> dict[str, Any]:
+        """``{"rule", "U", "acceptance_zone", "pass", "fail", "indeterminate",
+        "cycles_fail", "cycles_indeterminate"}``."""
+        return {
+            "rule": self.rule.value,
+            "U": self.U,
+            "acceptance_zone": None if self.zone is None else list(self.zone),
+            "pass": self.passed,
+            "fail": self.failed,
+            "indeterminate": self.indeterminate,
+            "cycles_fail": list(self.cycles_failed),
+            "cycles_indeterminate": list(self.cycles_indeterminate),
+        }
+
+
+def judge_readings(
+    values: Sequence[float] | np.ndarray,
+    cycles: Sequence[int] | np.ndarray,
+    lsl: float | None,
+    usl: float | None,
+    result: BudgetResult,
+    rule: Rule | str = Rule.GUARDED,
+) -> ReadingDecisions:
+    """:func:`decide` on every reading (labelled by ``cycles``) at once, with the same
+    ``result``: the figure a report shows is the figure the decisions took."""
+    rule = Rule(rule)
+    check_limits(lsl, usl)
+    array = np.asarray(values, dtype=float)
+    labels = np.asarray(cycles, dtype=np.int64)
+    guard = result.U if rule is Rule.GUARDED else 0.0
+    fail = np.zeros(array.shape, bool)
+    inside = np.ones(array.shape, bool)
+    if lsl is not None:
+        fail |= array < lsl - guard
+        inside &= array >= lsl + guard
+    if usl is not None:
+        fail |= array > usl + guard
+        inside &= array <= usl - guard
+    passed = inside & ~fail
+    if rule is Rule.SIMPLE:
+        fail = ~passed
+    between = ~passed & ~fail
+    return ReadingDecisions(
+        rule=rule,
+        U=result.U,
+        passed=int(passed.sum()),
+        failed=int(fail.sum()),
+        indeterminate=int(between.sum()),
+        cycles_failed=tuple(int(c) for c in labels[fail]),
+        cycles_indeterminate=tuple(int(c) for c in labels[between]),
+        zone=acceptance_zone(lsl, usl, result.U, rule),
+    )

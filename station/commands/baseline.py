@@ -15,7 +15,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "baseline",
         help="keep a capable session's control limits as a robot's baseline (phase II)",
         description=(
-            "With SESSION: record that finished, capable session of ROBOT as its baseline: the "
+            "With SESSION: record that finished session of ROBOT, CAPABLE on every channel "
+            "(Cpk's lower bound reaching the threshold; an INCONCLUSIVE one is refused with the "
+            "readings that would settle it), as its baseline: the "
             "centre line and control limits of every channel (and the moving-range limit), "
             "with the session's id, anchor and date, in the user's data folder "
             "($XDG_DATA_HOME/station/baselines). Later sessions of ROBOT can test their live "

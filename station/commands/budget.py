@@ -107,23 +107,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.json:
         document = {
-            "u_c": result.u_c,
-            "nu_eff": _finite(result.nu_eff),
-            "k": result.k,
-            "U": result.U,
-            "confidence": result.confidence,
-            "unit": result.unit,
-            "contributions": [
-                {
-                    "name": line.name,
-                    "u": line.u,
-                    "sensitivity": line.sensitivity,
-                    "ui": line.ui,
-                    "dof": _finite(line.dof),
-                    "share": line.share,
-                }
-                for line in result.lines
-            ],
+            **result.as_json(),
             "rule": rule.value,
             "limits": [lsl, usl] if limited else None,
             "acceptance_zone": list(zone) if zone else None,
@@ -140,11 +124,6 @@ def run(args: argparse.Namespace) -> int:
     else:
         _print_text(plain(args.file), result, rule, lsl, usl, zone, decisions, limited)
     return 0 if all(d.verdict is Outcome.PASS for d in decisions) else 1
-
-
-def _finite(value: float) -> float | None:
-    # JSON has no infinity: ∞ degrees of freedom are null.
-    return value if math.isfinite(value) else None
 
 
 def _print_text(source, result, rule, lsl, usl, zone, decisions, limited) -> None:  # noqa: ANN001

@@ -20,6 +20,10 @@ the file STATION_GAUGES names.
   station gauges status ID... [--json]   passed / failed / overdue / none
   station gauges record SESSION.jsonl    file a finished gauge_check,
                                          gauge_linearity or gage_rr session
+  station gauges certificate ID --U U --k K [--date D] [--number N]
+                                         record the gauge's calibration
+                                         certificate: U at k is a line of
+                                         every later session's budget
 
 A check is overdue when the calibration due date has passed or the check is
 older than 183 days (the report's "every four to six months").
@@ -54,7 +58,19 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="a gauge_check, gauge_linearity or gage_rr session file",
     )
     record.set_defaults(func=run_record)
-    for action in (listing, status, record):
+    certificate = actions.add_parser(
+        "certificate",
+        help="record a gauge's calibration certificate (U at k) for the measurement budget",
+    )
+    certificate.add_argument("gauge", metavar="ID", help="gauge id or serial")
+    certificate.add_argument(
+        "--U", dest="expanded", required=True, metavar="U", help="the certificate's expanded U"
+    )
+    certificate.add_argument("--k", required=True, metavar="K", help="its coverage factor")
+    certificate.add_argument("--date", metavar="YYYY-MM-DD", help="the certificate's date")
+    certificate.add_argument("--number", metavar="N", help="the certificate's number")
+    certificate.set_defaults(func=run_certificate)
+    for action in (listing, status, record, certificate):
         action.add_argument("--register", metavar="FILE", help="another register file")
 
 
@@ -121,4 +137,26 @@ def run_record(args: argparse.Namespace) -> int:
         raise StationError(f"{args.session} is not finished; finish it before recording it.")
     for sentence in method.file_in_register(Path(args.session), _register(args)):
         print(sentence)
+    return 0
+
+
+def run_certificate(args: argparse.Namespace) -> int:
+    """Record a gauge's calibration certificate (U at k) in the register."""
+    from station.commands._args import parse_number
+    from station.plain import plain
+    from station.session.gauge_register import record_certificate
+
+    expanded = parse_number(args.expanded, "--U")
+    k = parse_number(args.k, "--k")
+    if expanded is None or k is None:
+        raise StationError("--U and --k each need a number.")
+    path = _register(args)
+    entry = record_certificate(
+        path, args.gauge, expanded=expanded, k=k, date=args.date, certificate_id=args.number
+    )
+    print(
+        f"gauge {plain(args.gauge)}: certificate U = {entry['U']:g} at k = {entry['k']:g} "
+        f"recorded in {path}; sessions begun from now carry u = U/k = "
+        f"{entry['U'] / entry['k']:.4g} in their measurement budget"
+    )
     return 0

@@ -68,7 +68,7 @@ def session_source(session: Session) -> SessionSource:
         cycles=cycles,
         excluded_cycles=tuple(session.excluded_cycles),
         # The same settings the live analysis of the running session used.
-        config=analysis_config(session.header, session.zeroes),
+        config=analysis_config(session.header, session.zeroes, session.events),
         notes=tuple(notes),
         times={name: times for name, times in session.channel_times().items() if name in channels},
     )

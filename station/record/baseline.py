@@ -26,6 +26,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from station.analysis.verdict import CAPABLE, PROVISIONAL, Verdict, confidence_text
 from station.errors import StationError
 from station.record.source import AnalysedSession, analyse_session
 from station.session.durable import (
@@ -59,7 +60,13 @@ def _finite(value: Any) -> float | None:
 
 def make_baseline(analysed: AnalysedSession) -> dict[str, Any]:
     """The baseline record of a session: refused (StationError, with the sentence) unless the
-    session is finished, intact and capable on every channel it judges."""
+    session is finished, intact and CAPABLE on every channel it judges.
+
+    CAPABLE is the decision's word (Cpk's one-sided lower bound reaches the threshold), not the
+    report's point-estimate rule: a baseline's limits judge every later session of the robot,
+    so it must rest on a session the readings show capable. An INCONCLUSIVE (or PROVISIONAL)
+    session is refused with what would settle it (the readings needed at its Cpk), never kept
+    with a flag that a later session's alarms would not show."""
     session = analysed.session
     name = session.path.name
     if not session.finished:
@@ -77,6 +84,13 @@ def make_baseline(analysed: AnalysedSession) -> dict[str, Any]:
             f"{name} is not capable on {', '.join(not_capable)}: a baseline must be a capable "
             "session (its limits would judge later sessions)."
         )
+    unsettled = [
+        (str(key), channel.verdict)
+        for key, channel in analysis.channels.items()
+        if channel.verdict is None or channel.verdict.word != CAPABLE
+    ]
+    if unsettled:
+        raise StationError(f"{name} {_unsettled_sentence(unsettled)}")
     channels = {}
     for key, channel in analysis.channels.items():
         chart = channel.chart
@@ -105,6 +119,40 @@ def make_baseline(analysed: AnalysedSession) -> dict[str, Any]:
         "chart": analysis.channels[next(iter(analysis.channels))].chart.type,
         "channels": channels,
     }
+
+
+def _unsettled_sentence(unsettled: list[tuple[str, Verdict | None]]) -> str:
+    """Why a session capable by the report's rule is no baseline yet, and what would settle it:
+    ``is INCONCLUSIVE on x (Cpk 1.17, Bissell 95% bounds 0.90 to 1.44 straddle 1): ...``."""
+    parts, settle = [], []
+    for channel, verdict in unsettled:
+        if verdict is None:
+            parts.append(f"{channel} (no verdict)")
+            continue
+        if verdict.word == PROVISIONAL:
+            parts.append(f"{channel} ({verdict.label} readings)")
+            settle.append(f"{verdict.min_n - verdict.n} more readings on {channel}")
+            continue
+        level = f"Bissell {confidence_text(verdict.confidence)}"
+        lower = "undefined" if verdict.lower is None else f"{verdict.lower:.2f}"
+        upper = "undefined" if verdict.upper is None else f"{verdict.upper:.2f}"
+        parts.append(
+            f"{channel} ({verdict.word}: Cpk {verdict.cpk_text}, {level} bounds {lower} to "
+            f"{upper} straddle {verdict.threshold:g})"
+        )
+        if verdict.readings_needed is not None:
+            settle.append(f"{verdict.readings_needed} readings on {channel}")
+    settled = (
+        f"a session of {' and '.join(settle)} (at this Cpk) would settle it; capture one and "
+        "set that as the baseline"
+        if settle
+        else "no count of readings would settle it at this Cpk"
+    )
+    return (
+        f"is not shown CAPABLE on {'; '.join(parts)}: a baseline's limits judge every later "
+        "session, so it must be a session the readings show capable (the lower bound reaching "
+        f"the threshold), not only by the report's rule; {settled}."
+    )
 
 
 def store_baseline(robot: str, session_path: str | Path) -> dict[str, Any]:

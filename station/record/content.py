@@ -5,7 +5,8 @@ Everything is formatted here, once, so the three formats cannot disagree: the ro
 procedure (id, version, sha256), date and duration, gauges, zeroes, limits, every reading with
 the rejects and their reasons, notes, alarms with their acknowledgements, the overall verdict
 (the session's word and each channel's, with Cpk and its one-sided Bissell bounds), every judged
-channel's statistics as the text report (``station analyze``) gives them, hints, the
+channel's statistics as the text report (``station analyze``) gives them, each channel's
+measurement budget, hints, the
 procedure's own blocks, the anchor (the last line's hash) and the signature id, and the sign-off
 lines. Text from outside stays raw here; each
 format escapes it (see :mod:`station.record.text`).
@@ -19,7 +20,10 @@ from datetime import datetime
 from typing import Any
 
 from station.analysis.report import (
+    budget_rows,
+    budget_summary,
     channel_figures,
+    decisions_text,
     format_figures,
     format_judgement,
     format_out_of_spec,
@@ -127,8 +131,9 @@ class Verdict:
     cpk: str
     cpk_lower: str
     cpk_upper: str
+    """Bissell's one-sided upper bound on Cpk: with the lower one, what the verdict weighed."""
     confidence: str
-    """The one-sided confidence level of ``cpk_lower`` and ``cpk_upper`` (``95%``)."""
+    """The one-sided confidence level of each of ``cpk_lower`` and ``cpk_upper`` (``95%``)."""
     word: str
     message: str
     decision: str = ""
@@ -150,6 +155,21 @@ class ChannelStatistics:
     figure_lines: tuple[str, ...]
     """``figures`` laid out as the text report lays them out (the txt format prints these)."""
     lines: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class BudgetBlock:
+    """One channel's measurement budget: the table rows (input, u, |c|·u, dof, share), u_c and
+    U at k in a line, and the readings as the decision rule judged them with that U."""
+
+    name: str
+    rows: tuple[tuple[str, ...], ...]
+    summary: str
+    decisions: str
+
+
+BUDGET_HEADER = ("input", "u", "|c|·u", "dof", "share")
+"""The columns of a budget table."""
 
 
 @dataclass(frozen=True)
@@ -204,6 +224,9 @@ class ReportContent:
     """Why there is no analysis ("" when there is one)."""
     torn: str
     """The torn tail's message ("" for an intact file)."""
+    budgets: tuple[BudgetBlock, ...] = ()
+    """Each judged channel's measurement budget (none when nothing of it is known)."""
+    budget_header: tuple[str, ...] = BUDGET_HEADER
     sign_off: tuple[str, ...] = SIGN_OFF
 
 
@@ -494,6 +517,26 @@ def _statistics(analysed: AnalysedSession) -> tuple[ChannelStatistics, ...]:
     )
 
 
+def _budgets(analysed: AnalysedSession, resolution: float | None) -> tuple[BudgetBlock, ...]:
+    if analysed.report is None or analysed.report.analysis is None:
+        return ()
+    unit = analysed.report.analysis.config.unit
+    blocks = []
+    for channel in analysed.report.analysis.channels.values():
+        if channel.budget is None:
+            continue
+        decisions = channel.reading_decisions
+        blocks.append(
+            BudgetBlock(
+                name=str(channel.name),
+                rows=tuple(budget_rows(channel.budget, resolution)),
+                summary=budget_summary(channel.budget, resolution, unit),
+                decisions="" if decisions is None else decisions_text(decisions, resolution, unit),
+            )
+        )
+    return tuple(blocks)
+
+
 def _figures(analysed: AnalysedSession, resolution: float | None) -> tuple[tuple[str, str], ...]:
     if analysed.report is None or analysed.report.analysis is None:
         return ()
@@ -588,6 +631,7 @@ def build_content(analysed: AnalysedSession) -> ReportContent:
         overall=overall,
         overall_basis=overall_basis,
         statistics=_statistics(analysed),
+        budgets=_budgets(analysed, resolution),
         figures=_figures(analysed, resolution),
         sections=report.sections if report is not None else (),
         hints=tuple(report.analysis.hints) if report is not None and report.analysis else (),

@@ -600,7 +600,10 @@ class Runner(InstrumentIntake, AlarmJournal, StepServices, LiveNotices):
         """The analysis config with the recorded zeros' uncertainties, and a new (empty) live
         analysis on it when that changed (the caller feeds it the cycles); True then."""
         config = analysis_config(self.header, [{"channels": self.recorded_zero}])
-        if config.zero_uncertainty == self.config.zero_uncertainty:
+        if (config.zero_uncertainty, config.zero_draws) == (
+            self.config.zero_uncertainty,
+            self.config.zero_draws,
+        ):
             return False
         self.config = config
         self._live = self.method.live(self.config, self.setup.channels, self.header)

@@ -218,6 +218,9 @@ class SessionSetup:
             **({"strokes_target": self.strokes} if self.strokes else {}),
             "rules": self.rule_set,
             "threshold": self.threshold,
+            # How a reading is judged against its limits with the measurement budget's U
+            # (ISO 14253-1 guarded acceptance); kept so a later station judges it alike.
+            "decision_rule": "guarded",
             **({"baseline": dict(self.baseline)} if self.baseline else {}),
             **({"gauges": dict(self.gauges)} if self.gauges else {}),
         }

@@ -8,12 +8,19 @@ the calibration due date::
 
     {"format": "station-gauges/1",
      "gauges": {"MIT-543-0042": {"calibration_due": "2027-05-01",
+                                 "certificate": {"U": 0.00004, "k": 2, "date": "2026-10-01",
+                                                 "id": "C-12"},
                                  "checks": [{"date": "2026-11-29", "result": "passed",
                                              "cg": 2.1, "cgk": 1.8, "bias": 0.00002,
                                              "bias_p": 0.31, "reference": 1.0,
-                                             "tolerance": 0.002, "session": "..."}],
+                                             "tolerance": 0.002, "n": 25, "sd": 0.00003,
+                                             "session": "..."}],
                                  "studies": {"gauge_linearity": [{"date": "2026-11-30",
                                              "result": "acceptable", "slope": 0.0002, ...}]}}}}
+
+The certificate (:func:`record_certificate`) and the latest check's SD (its repeatability) are
+lines of every later session's measurement budget: a session records them in its header's
+``gauge_checks`` snapshot when it begins (:meth:`GaugeStatus.as_json`).
 
 Other studies of a gauge (a linearity and bias study over its travel) are kept beside its checks,
 per method (:func:`record_study`); they do not decide whether a check covers the gauge.
@@ -36,6 +43,7 @@ import datetime as dt
 import errno
 import fcntl
 import json
+import math
 import os
 import textwrap
 from collections.abc import Iterator, Mapping
@@ -170,6 +178,8 @@ def record_check(
         "reference": study.reference,
         "tolerance": study.tolerance,
         "n": study.n,
+        # The repeatability a later session's measurement budget takes (s on n − 1).
+        "sd": study.sd,
     }
     if session:
         entry["session"] = session
@@ -268,6 +278,12 @@ class GaugeStatus:
     cg: float | None = None
     cgk: float | None = None
     reason: str = ""
+    sd: float | None = None
+    """The latest Type-1 check's sample SD (its repeatability), None when not recorded."""
+    n: int | None = None
+    """How many readings that SD is of."""
+    certificate: Mapping[str, Any] | None = None
+    """The gauge's calibration certificate as recorded (``{"U", "k", "date", "id"}``)."""
 
     @property
     def covered(self) -> bool:
@@ -304,6 +320,9 @@ class GaugeStatus:
             else self.calibration_due.isoformat(),
             "cg": self.cg,
             "cgk": self.cgk,
+            "sd": self.sd,
+            "n": self.n,
+            "certificate": None if self.certificate is None else dict(self.certificate),
             "reason": self.reason,
             "sentence": self.sentence(),
         }
@@ -317,13 +336,21 @@ def gauge_status(
     calibration due date has passed, or its last check is older than ``valid_days``) or
     ``passed``."""
     record = register.get("gauges", {}).get(str(gauge).strip())
+    certificate = certificate_of(record)
     if not record or not record.get("checks"):
-        return GaugeStatus(str(gauge), "none", None, None)
+        return GaugeStatus(str(gauge), "none", None, None, certificate=certificate)
     last = record["checks"][-1]
     checked = parse_date(last["date"], "check date")
     due = record.get("calibration_due")
     due_date = None if not due else parse_date(due, "calibration due date")
-    common = {"cg": last.get("cg"), "cgk": last.get("cgk")}
+    sd, n = check_repeatability(last)
+    common = {
+        "cg": last.get("cg"),
+        "cgk": last.get("cgk"),
+        "sd": sd,
+        "n": n,
+        "certificate": certificate,
+    }
     if last.get("result") != "passed":
         cg, cgk = last.get("cg"), last.get("cgk")
         detail = (
@@ -352,6 +379,98 @@ def gauge_status(
             **common,
         )
     return GaugeStatus(str(gauge), "passed", checked, due_date, **common)
+
+
+def _positive(value: Any) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return None
+    return float(value) if math.isfinite(value) and value > 0 else None
+
+
+def check_repeatability(check: Mapping[str, Any]) -> tuple[float | None, int | None]:
+    """A Type-1 check entry's repeatability: its sample SD and count. An entry from before the
+    SD was recorded gives it back from Cg and the tolerance (Cg = 0.2·T / 6s, the check's own
+    formula, :mod:`station.analysis.gauge_check`); (None, None) when neither is there."""
+    n = check.get("n")
+    count = n if isinstance(n, int) and not isinstance(n, bool) and n >= 2 else None
+    if count is None:
+        return None, None
+    sd = check.get("sd")
+    if isinstance(sd, int | float) and not isinstance(sd, bool) and math.isfinite(sd) and sd >= 0:
+        return float(sd), count
+    cg, tolerance = _positive(check.get("cg")), _positive(check.get("tolerance"))
+    if cg is None or tolerance is None:
+        return None, None
+    # Deferred: the register is read by commands that need no numpy.
+    from station.analysis.gauge_check import PERCENT_OF_TOLERANCE, SPREAD_SIGMAS
+
+    return (PERCENT_OF_TOLERANCE / 100 * tolerance) / (SPREAD_SIGMAS * cg), count
+
+
+def certificate_of(record: Mapping[str, Any] | None) -> dict[str, Any] | None:
+    """A gauge's calibration certificate as the register holds it (``{"U", "k", "date",
+    "id"}``), None when none is recorded or its U and k are not usable numbers."""
+    found = (record or {}).get("certificate")
+    if not isinstance(found, Mapping):
+        return None
+    expanded, k = found.get("U"), _positive(found.get("k"))
+    if isinstance(expanded, bool) or not isinstance(expanded, int | float) or k is None:
+        return None
+    if not (math.isfinite(expanded) and expanded >= 0):
+        return None
+    return {
+        "U": float(expanded),
+        "k": k,
+        "date": found.get("date"),
+        "id": found.get("id"),
+    }
+
+
+def record_certificate(
+    path: Path,
+    gauge: str,
+    *,
+    expanded: float,
+    k: float,
+    date: dt.date | str | None = None,
+    certificate_id: str | None = None,
+    calibration_due: dt.date | str | None = None,
+) -> dict[str, Any]:
+    """Record ``gauge``'s calibration certificate in the register at ``path``: its expanded
+    uncertainty ``expanded`` at coverage ``k`` (the budget's certificate line is U/k), the
+    date and number of the certificate; it replaces the one recorded before. StationError on
+    a U that is negative or not finite, a k that is not above 0, or a register that cannot be
+    written."""
+    from station.analysis.uncertainty import check_coverage
+
+    if isinstance(expanded, bool) or not isinstance(expanded, int | float):
+        raise StationError(f"the certificate's U must be a number, not {expanded!r}.")
+    if not (math.isfinite(expanded) and expanded >= 0):
+        raise StationError(
+            f"the certificate's U must be a finite number 0 or more, not {expanded!r}."
+        )
+    entry: dict[str, Any] = {
+        "U": float(expanded),
+        "k": check_coverage(k, "the certificate's k"),
+        "date": None if date in (None, "") else parse_date(date, "certificate date").isoformat(),
+        "id": None if not certificate_id else str(certificate_id),
+    }
+    key = _gauge_key(gauge)
+    due = None if calibration_due in (None, "") else parse_date(calibration_due, "calibration due")
+    try:
+        make_folders(path.parent)
+        with _locked(path):
+            content = load_register(path)
+            record = content["gauges"].setdefault(key, {"calibration_due": None, "checks": []})
+            record["certificate"] = entry
+            if due is not None:
+                record["calibration_due"] = due.isoformat()
+            _write(path, content)
+    except OSError as error:
+        raise StationError(
+            f"cannot write the gauge register {path}: {error.strerror or error}."
+        ) from None
+    return entry
 
 
 def coverage(

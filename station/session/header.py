@@ -16,6 +16,7 @@ from typing import Any
 from station.analysis.capability import SpecLimits
 from station.analysis.phases import DEFAULT_FREEZE_AFTER, baseline_from_json
 from station.analysis.summary import AnalysisConfig
+from station.analysis.uncertainty import GaugeRecord
 from station.analysis.verdict import DEFAULT_MIN_N
 from station.analysis.zeros import ZeroDraw
 
@@ -46,6 +47,43 @@ def zero_uncertainties(zeroes: Iterable[Mapping[str, Any]]) -> dict[str, float]:
                 found[str(channel)] = float(value)
             else:
                 found.pop(str(channel), None)
+    return found
+
+
+def _figure(value: object) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        return None
+    return float(value)
+
+
+def gauge_records(header: Mapping[str, Any]) -> dict[str, GaugeRecord]:
+    """Per channel, what the gauge register said of its gauge when the session began (the
+    header's ``gauge_checks`` snapshot): the certificate's U and k, the latest Type-1 check's
+    SD and count. A session's budget rests on that snapshot, never on the register of today,
+    so a report printed later gives the same U. Channels with nothing usable are left out."""
+    found: dict[str, GaugeRecord] = {}
+    for channel, status in dict(header.get("gauge_checks") or {}).items():
+        if not isinstance(status, Mapping):
+            continue
+        certificate = status.get("certificate")
+        expanded = k = None
+        if isinstance(certificate, Mapping):
+            expanded, k = _figure(certificate.get("U")), _figure(certificate.get("k"))
+            if expanded is None or expanded < 0 or k is None or k <= 0:
+                expanded = k = None
+        sd, n = _figure(status.get("sd")), status.get("n")
+        count = n if isinstance(n, int) and not isinstance(n, bool) and n >= 2 else None
+        if sd is None or sd < 0 or count is None:
+            sd = count = None
+        if expanded is None and sd is None:
+            continue
+        found[str(channel)] = GaugeRecord(
+            gauge=str(status.get("gauge") or ""),
+            certificate_U=expanded,
+            certificate_k=k,
+            repeatability_sd=sd,
+            repeatability_n=count,
+        )
     return found
 
 
@@ -96,12 +134,28 @@ def zero_draws(events: Iterable[Mapping[str, Any]]) -> dict[str, tuple[ZeroDraw,
     }
 
 
+def _draws_in_force(zeroes: Iterable[Mapping[str, Any]]) -> dict[str, tuple[ZeroDraw, ...]]:
+    """Per channel, the zero in force (its last ``zero`` event) as the one draw its readings
+    carry: what the zero events alone can say, without the readings that weight each zero."""
+    found: dict[str, tuple[ZeroDraw, ...]] = {}
+    for event in zeroes:
+        for channel, spec in dict(event.get("channels") or {}).items():
+            draw = _zero_draw(spec)
+            found[str(channel)] = (ZeroDraw(draw.readings, draw.within_sd, 1),)
+    return found
+
+
 def analysis_config(
-    header: Mapping[str, Any], zeroes: Iterable[Mapping[str, Any]] = ()
+    header: Mapping[str, Any],
+    zeroes: Iterable[Mapping[str, Any]] = (),
+    events: Iterable[Mapping[str, Any]] | None = None,
 ) -> AnalysisConfig:
     """The :class:`AnalysisConfig` a session header implies: its limits, resolution, unit, rule
-    set and threshold (single readings, subgroup 1); ``zeroes`` (the session's ``zero``
-    events) give each channel's zero uncertainty."""
+    set and threshold (single readings, subgroup 1), the gauges' register snapshot (for the
+    measurement budget); ``zeroes`` (the session's ``zero`` events) give each channel's zero
+    uncertainty; ``events`` (all of them, when known) weight each zero by the readings taken
+    under it, else the zero in force is the one draw (the running engine's view)."""
+    zeroes = list(zeroes)
     resolution = header.get("resolution")
     # Streamed strokes are judged one straightness per stroke: their verdict is final from the
     # strokes the procedure's stroke step asks for, not from its count of cycles.
@@ -117,6 +171,9 @@ def analysis_config(
         freeze_after=freeze if isinstance(freeze, int) and freeze >= 2 else DEFAULT_FREEZE_AFTER,
         baseline=baseline_from_json(header.get("baseline")),
         zero_uncertainty=zero_uncertainties(zeroes),
+        zero_draws=_draws_in_force(zeroes) if events is None else zero_draws(events),
+        gauges=gauge_records(header),
+        decision_rule=str(header.get("decision_rule") or "guarded"),
     )
 
 

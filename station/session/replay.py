@@ -542,7 +542,7 @@ def _check_trace(replay: Replay, record: Mapping[str, Any]) -> None:
     """A return's trace: ``cycle`` (a recorded cycle), ``step``, ``channels``, ``values`` (rows),
     ``times`` (one per row, s after ``t0``, never going back), ``every`` (rows per row kept)."""
     cycle = _need_cycle(record)
-    if cycle not in replay.cycles:
+    if cycle not in replay.cycle_seqs:
         raise ValueError(f"a trace event names cycle {cycle}, which is not a recorded cycle")
     values = _check_rows(replay, record, "trace")
     times = record.get("times")

@@ -6,6 +6,7 @@ import numpy as np
 
 from station.analysis.capability import SpecLimits
 from station.analysis.summary import AnalysisConfig, analyze
+from station.analysis.zeros import ZeroDraw
 
 LIMITS = SpecLimits(lsl=-0.001, usl=0.001, nominal=0.0)
 
@@ -73,8 +74,8 @@ def test_an_offset_the_zero_explains_is_said_to_be_the_zeros():
     # (2u) is no evidence against the robot (the issue's one-reading zero of -0.0010).
     values = noise() + 0.0002
     (hint,) = [h for h in hints(values, zero_uncertainty={"x": 0.00015}) if "off nominal" in h]
-    assert "within what the zero's own uncertainty (±0.00030 in) explains" in hint
-    assert "zero again from more readings" in hint
+    assert "within what the zero's uncertainty (±0.00030 in, rest to rest) explains" in hint
+    assert "a zero is one rest of the robot" in hint
     assert "inverse kinematics" not in hint
 
 
@@ -82,5 +83,23 @@ def test_an_offset_beyond_the_zeros_uncertainty_still_points_at_the_robot():
     values = noise() + 0.0004
     (hint,) = [h for h in hints(values, zero_uncertainty={"x": 0.00003}) if "off nominal" in h]
     # At the figures' decimals like the average beside it, never in scientific notation.
-    assert "beyond the zero's own uncertainty (±0.00006 in)" in hint
+    assert "beyond the zero's uncertainty (±0.00006 in, rest to rest)" in hint
     assert "inverse kinematics" in hint
+
+
+def test_the_offset_hint_weighs_the_zeros_rest_to_rest_draw_not_its_within_rest_noise():
+    """Issue 20: a zero of 5 readings at one rest of a still gauge has a tiny within-rest
+    uncertainty, yet it is one draw of the robot's repeatability: Var(z) = s² − (1 − 1/m)·s_w²
+    (here s_w = 0, so Var(z) = s²). An offset of 1.5 s is within that draw, not the robot's."""
+    values = noise() + 0.00015
+    sd = float(np.std(values, ddof=1))
+    within_only = {"zero_uncertainty": {"x": 0.00003}}
+    (blamed,) = [h for h in hints(values, **within_only) if "off nominal" in h]
+    assert "inverse kinematics" in blamed  # the old comparison
+    drawn = within_only | {"zero_draws": {"x": (ZeroDraw(readings=5, within_sd=0.0, weight=30),)}}
+    (hint,) = [h for h in hints(values, **drawn) if "off nominal" in h]
+    assert "inverse kinematics" not in hint
+    assert f"(±{2 * sd:.5f} in, rest to rest)" in hint
+    # A real offset well beyond the draw is still the robot's.
+    (far,) = [h for h in hints(noise() + 0.0006, **drawn) if "off nominal" in h]
+    assert "inverse kinematics" in far and "beyond the zero's uncertainty" in far

@@ -9,15 +9,18 @@ import pytest
 from station.analysis.uncertainty import (
     Budget,
     Contribution,
+    GaugeRecord,
     Outcome,
     Rule,
     acceptance_zone,
+    channel_budget,
     check_limits,
     cosine_error,
     decide,
     evaluate,
     from_expanded,
     from_half_width,
+    judge_readings,
     repeatability,
     resolution,
     temperature,
@@ -237,3 +240,56 @@ def test_impossible_limits_are_refused(lsl, usl, words):
     assert words in caught.value.message
     with pytest.raises(StationError):
         decide(0.0, lsl, usl, U_QUARTER)
+
+
+# -- a session channel's budget and the decisions on its readings ------------------------------
+
+
+def test_a_channel_budget_from_what_a_session_records():
+    gauge = GaugeRecord(
+        "G-1", certificate_U=0.0001, certificate_k=2.0, repeatability_sd=0.00005, repeatability_n=25
+    )
+    budget = channel_budget(0.0001, gauge, 0.00003, "in")
+    assert budget is not None and budget.unit == "in"
+    result = evaluate(budget)
+    # By hand: r/√12, U/k, s (24 dof), the zero's u.
+    parts = [0.0001 / math.sqrt(12), 0.00005, 0.00005, 0.00003]
+    u_c = math.sqrt(sum(p * p for p in parts))
+    assert [line.u for line in result.lines] == pytest.approx(parts, rel=1e-12)
+    assert result.u_c == pytest.approx(u_c, rel=1e-12)
+    assert result.nu_eff == pytest.approx(u_c**4 / (0.00005**4 / 24), rel=1e-12)
+    assert (result.k, result.U) == (2.0, pytest.approx(2 * u_c, rel=1e-12))
+    assert [line.name for line in result.lines] == [
+        "gauge step (r/2 rectangular)",
+        "certificate (U at k = 2)",
+        "repeatability (Type-1, n = 25)",
+        "zero",
+    ]
+    json_lines = result.as_json()["contributions"]
+    assert json_lines[0]["dof"] is None and json_lines[2]["dof"] == 24.0
+    # What is not recorded is not a line; nothing recorded is no budget at all.
+    assert [c.name for c in channel_budget(0.0001).contributions] == [  # type: ignore[union-attr]
+        "gauge step (r/2 rectangular)"
+    ]
+    assert channel_budget(None, GaugeRecord("G-2"), None) is None
+
+
+def test_every_reading_is_decided_as_decide_would_with_the_same_budget():
+    values = [0.0, 0.75, 0.75 + NUDGE, 1.0, 1.25, 1.25 + NUDGE, -0.75 - NUDGE, -7.0]
+    cycles = list(range(3, 3 + len(values)))
+    for rule in Rule:
+        found = judge_readings(values, cycles, *LIMITS, U_QUARTER, rule)
+        one_by_one = [decide(v, *LIMITS, U_QUARTER, rule).verdict for v in values]
+        assert found.passed == one_by_one.count(Outcome.PASS)
+        assert found.failed == one_by_one.count(Outcome.FAIL)
+        assert found.indeterminate == one_by_one.count(Outcome.INDETERMINATE)
+        assert found.cycles_failed == tuple(
+            c for c, v in zip(cycles, one_by_one, strict=True) if v is Outcome.FAIL
+        )
+        assert found.cycles_indeterminate == tuple(
+            c for c, v in zip(cycles, one_by_one, strict=True) if v is Outcome.INDETERMINATE
+        )
+        assert found.U == U_QUARTER.U
+    guarded = judge_readings(values, cycles, *LIMITS, U_QUARTER)
+    assert (guarded.passed, guarded.failed, guarded.indeterminate) == (2, 2, 4)
+    assert guarded.zone == (-0.75, 0.75)

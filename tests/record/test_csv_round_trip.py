@@ -58,6 +58,10 @@ def test_export_then_analyze_gives_the_session_analysis(kind, layout, sessions, 
     # record, not its analysis: a table of readings cannot carry them.
     assert "recorded_alarms" in from_session and "recorded_alarms" not in from_table
     from_session.pop("recorded_alarms")
+    # So are the zeros' own readings: the off-nominal hint of a table weighs the offset without
+    # the zero's rest-to-rest draw (issue 20), so it may word the same offset differently.
+    for document in (from_session, from_table):
+        document["hints"] = [h for h in document.get("hints", []) if "off nominal" not in h]
     assert from_table == from_session
     excluded = {"repeatability": [2], "relative_accuracy": [3], "linearity": []}
     assert from_session["excluded_cycles"] == excluded[kind]

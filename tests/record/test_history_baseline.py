@@ -152,17 +152,20 @@ def test_text_chart_places_the_extremes_on_the_top_and_bottom_rows():
 def test_baseline_is_stored_loaded_marked_and_cleared(sessions, capsys):
     paths = five_sessions(sessions)
     assert baseline_for("KSC-7") is None
-    assert main(["baseline", "KSC-7", str(paths[1])]) == 0
+    # The second session is capable by the report's rule but INCONCLUSIVE on y: no baseline.
+    assert main(["baseline", "KSC-7", str(paths[1])]) == 2
+    assert "not shown CAPABLE on y (INCONCLUSIVE" in capsys.readouterr().err
+    assert main(["baseline", "KSC-7", str(paths[0])]) == 0
     record = baseline_for("KSC-7")
     assert record is not None
     assert set(record["channels"]) == {"x", "y", "z"}
     x = record["channels"]["x"]
     assert x["lcl"] < x["center"] < x["ucl"] and x["mr_ucl"] > 0
-    assert record["anchor"] in paths[1].read_text()
+    assert record["anchor"] in paths[0].read_text()
     assert baseline_path("KSC-7").parent.parent.parent == Path(os.environ["XDG_DATA_HOME"])
 
     history = robot_history(sessions, "KSC-7")
-    assert [e.baseline for e in history.entries] == [False, True, False, False, False]
+    assert [e.baseline for e in history.entries] == [True, False, False, False, False]
     capsys.readouterr()
     assert main(["history", "KSC-7", "--sessions", str(sessions)]) == 0
     assert capsys.readouterr().out.count("[baseline]") == 1
@@ -265,3 +268,26 @@ def test_a_short_session_is_provisional_in_the_history_as_in_its_report(sessions
     write_repeatability(sessions, robot="KSC-7", seed=4, cycles=DEFAULT_MIN_N - 5, reject=None)
     (entry,) = robot_history(sessions, "KSC-7").entries
     assert entry.verdict == f"PROVISIONAL: {DEFAULT_MIN_N - 5} of {DEFAULT_MIN_N}"
+
+
+def test_an_inconclusive_session_is_no_baseline_and_the_refusal_says_what_settles_it(
+    sessions, capsys
+):
+    """Baseline policy (issue 20): capable by the report's rule (Cpk >= 1) but INCONCLUSIVE by
+    its Bissell bounds is refused, naming the bounds and the readings that would settle it;
+    nothing is stored. A CAPABLE session of the same robot is then accepted."""
+    from station.record.source import analyse_session
+
+    wide = write_repeatability(sessions, robot="R1", noise={"x": 0.00027}, seed=4)
+    channel = analyse_session(wide).report.analysis.channels["x"]
+    verdict = channel.verdict
+    assert channel.capability.capable is True and verdict.word == "INCONCLUSIVE"
+    assert verdict.readings_needed is not None
+    assert main(["baseline", "R1", str(wide)]) == 2
+    said = capsys.readouterr().err
+    assert "not shown CAPABLE on x (INCONCLUSIVE: Cpk" in said
+    assert f"bounds {verdict.lower:.2f} to {verdict.upper:.2f} straddle 1" in said
+    assert f"a session of {verdict.readings_needed} readings on x (at this Cpk)" in said
+    assert len(said.strip().splitlines()) == 1
+    assert baseline_for("R1") is None
+    assert store_baseline("R1", write_repeatability(sessions, robot="R1"))["robot"] == "R1"

@@ -172,6 +172,9 @@ def facts(content) -> list[str]:
         said.append(block.heading)
         said += [f"{label} {value}" for label, value in block.figures]
         said += [line.strip() for line in block.lines if line.strip()]
+    for budget in content.budgets:
+        said += [cell for row in budget.rows for cell in row]
+        said += [budget.summary, budget.decisions]
     for row in content.readings:
         said += [*row.values, row.status]
     said += [f"Rejected cycle {cycle}: {reason}" for cycle, reason in content.rejected]
@@ -370,3 +373,19 @@ def test_the_text_report_names_rules_in_words_with_acks_and_a_provisional_verdic
     assert "acknowledged: gauge; re-clamped the x indicator" in text
     assert "PROVISIONAL: 9 of 25" in text
     assert " CAPABLE" not in text.replace("NOT CAPABLE", "")
+
+
+def test_the_filed_report_shows_cpks_upper_bound_beside_the_lower(sessions):
+    """INCONCLUSIVE rests on both one-sided bounds: the filed report shows both, and says they
+    are Bissell's and one-sided (issue 20)."""
+    path = write_repeatability(sessions, robot="bounds", noise={"x": 0.0003})
+    analysis = analyse_session(path).report.analysis
+    cap = analysis.channels["x"].capability
+    assert cap.cpk_upper is not None and cap.cpk_lower is not None
+    lower, upper = f"{cap.cpk_lower:.2f}", f"{cap.cpk_upper:.2f}"
+    text = render_report(path, "txt")
+    assert f"Cpk one-sided 95% bounds (Bissell): lower {lower}, upper {upper}" in text
+    assert f"{lower} / {upper} (95%)" in render_report(path, "md")
+    html = render_report(path, "html")
+    assert "Cpk one-sided bounds, lower / upper (confidence, Bissell)" in html
+    assert f"{lower} / {upper} (95%)" in html

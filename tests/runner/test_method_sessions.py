@@ -323,7 +323,7 @@ def test_gain_schedule_session_from_typed_gains(tmp_path: Path):
     # The filed report of a session without a capability analysis: the fit under VERDICTS.
     report = run_station("report", str(path))
     assert report.returncode == 0, report.stderr
-    assert "GAIN SCHEDULE: 9 positions" in report.stdout.split("VERDICTS", 1)[1]
+    assert "GAIN SCHEDULE: 9 positions" in report.stdout.split("VERDICT:", 1)[1]
 
 
 def test_a_repeatability_session_says_which_gauge_check_covers_it(tmp_path: Path):

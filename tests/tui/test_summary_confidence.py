@@ -32,5 +32,8 @@ def test_table_2_1_summary_is_inconclusive_with_bounds_and_the_reports_rule():
     assert "(lower–upper) its one-sided 95% bounds, Bissell" in text
     assert "x  INCONCLUSIVE Cp 1.26  Cpk 1.17 (0.90–1.44)" in text
     assert "77 readings settle it; by the report's rule: capable, Cpk 1.17 >= 1" in text
+    # The U the readings were decided with (the gauge step alone: r/√12 at k = 2; the view
+    # has no resolution, so six decimals).
+    assert "measurement U 0.000058 in, k = 2: 30 PASS 0 FAIL 0 INDETERMINATE" in text
     # Each axis line fits the summary at 80 columns (the header wraps as the widget does).
     assert all(cell_len(line) <= 74 for line in text.splitlines()[1:]), text

@@ -25,6 +25,7 @@ from textual.containers import VerticalScroll
 from textual.screen import Screen
 from textual.widgets import Static
 
+from station.analysis.report import budget_line
 from station.analysis.rules import rule_name
 from station.analysis.verdict import confidence_text
 from station.errors import StationError
@@ -232,6 +233,12 @@ def verdict_text(view: SummaryView) -> Text:
                 else ""
             )
             text.append(f"    {settle}{verdict.rule_text}\n", style="dim")
+        if channel.budget is not None:
+            # The U the readings' decisions took, so the figure shown is the figure used.
+            line = budget_line(
+                channel.budget, channel.reading_decisions, view.resolution, view.unit
+            )
+            text.append(f"      {line}\n", style="dim")
         if word == "UNDEFINED" and capability.message:
             text.append(f"      {shown_line(capability.message, limit=None)}\n", style="yellow")
         one_sided = one_sided_sentence(capability, view.resolution, view.unit)
