@@ -394,7 +394,6 @@ class SetupScreen(ConnectionTestScreen):
             setup = read_setup(
                 self.form_value,
                 self._procedure(),
-                demo=self.app.config.demo is not None,
                 operator=login_name(),
                 errors=errors,
             )

@@ -42,8 +42,6 @@ TRIGGER_CHOICES = (
 TYPED_PORT = "__typed__"
 DEMO_LIMITS = "±0.001"
 """The report's example tolerance, offered in the demo when a procedure has no default limits."""
-DEMO_TRIAL_MINIMUM = 2
-"""The fewest cycles, placements or strokes a demo's trial run may ask for."""
 KEPT_ON_PROCEDURE_CHANGE = ("robot", "operator", "port", "protocol", "map", "trigger")
 
 SelectMaker = Callable[..., Select]
