@@ -125,3 +125,43 @@ def test_the_set_up_counts_in_the_procedures_words_no_fewer_than_it_can_judge(
     args.count = fewest - 1
     with pytest.raises(StationError, match=f"give at least {fewest} {label.lower()}"):
         demo._demo_choice(args)
+
+
+def shown_map(app: StationApp) -> str | None:
+    """The set-up's channel map, once the (new) set-up screen has it."""
+    fields = app.screen.query("#map")
+    return fields.first(Input).value if fields else None
+
+
+async def test_a_gauge_check_takes_its_own_channel_map_and_trigger(tmp_path: Path, tui) -> None:
+    """The gauge check's set-up offered the repeatability's channel map (1=x,2=y,3=z) and its
+    arrival trigger, remembered from the last session or kept across a change of procedure;
+    against a one-indicator bench it zeroed on the block (Cgk −814.56). The line is kept, the
+    map and the trigger follow the procedure."""
+    from station.session.remembered import RememberedSetup, save_remembered
+    from station.tui.app import StationConfig
+
+    save_remembered(
+        RememberedSetup(
+            robot="R1", port="/dev/ttyUSB7", channel_map="1=x,2=y,3=z", trigger="arrival"
+        )
+    )
+    app = StationApp(StationConfig(sessions_dir=tmp_path, sessions_reason="test folder"))
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        app.screen.open_new("gauge_check")
+        await tui.wait_until(pilot, lambda: app.screen.query("#map"))
+        await pilot.pause()
+        assert app.screen.query_one("#port", Input).value == "/dev/ttyUSB7"
+        assert app.screen.query_one("#map", Input).value == "1=x"
+        assert app.screen.query_one("#trigger", Select).value == "poll"
+        # To the repeatability (its three channels), then back to the gauge check.
+        app.screen.query_one("#procedure", Select).value = "repeatability"
+        await tui.wait_until(pilot, lambda: shown_map(app) == "1=x,2=y,3=z")
+        await pilot.pause()
+        app.screen.query_one("#trigger", Select).value = "arrival"
+        app.screen.query_one("#procedure", Select).value = "gauge_check"
+        await tui.wait_until(pilot, lambda: shown_map(app) == "1=x")
+        await pilot.pause()
+        assert app.screen.query_one("#trigger", Select).value == "poll"
+        assert app.screen.query_one("#port", Input).value == "/dev/ttyUSB7"
