@@ -165,3 +165,37 @@ async def test_a_gauge_check_takes_its_own_channel_map_and_trigger(tmp_path: Pat
         await pilot.pause()
         assert app.screen.query_one("#trigger", Select).value == "poll"
         assert app.screen.query_one("#port", Input).value == "/dev/ttyUSB7"
+
+
+async def test_the_gauge_checks_set_up_and_zero_speak_of_its_bench(
+    lab: DemoLab, tmp_path: Path, tui
+) -> None:
+    """The gauge check's set-up showed the limits hint with no limits field, and its zero on a
+    surface plate said "Keep the robot still"."""
+    from station.tui.autopilot import _fill_inputs
+    from station.tui.screens.checklist import ChecklistScreen
+
+    args = demo_args("gauge_check")
+    config = demo.demo_config(args, demo._demo_choice(args), lab, tmp_path, "a test folder")
+    app = StationApp(dataclasses.replace(config, autopilot=False))
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("n")
+        await tui.wait_until(pilot, lambda: isinstance(app.screen, SetupScreen), timeout=20)
+        await pilot.pause()
+        assert not app.screen.query("Input#limits-x")
+        assert "LSL:USL" not in tui.screen_text(app)
+        await pilot.press("f2")
+        while (state := app.runner.state()).action.kind != "zero":
+            await tui.wait_until(pilot, lambda: isinstance(app.screen, ChecklistScreen))
+            screen = app.screen
+            await tui.wait_until(pilot, lambda screen=screen: not screen.busy)
+            if state.action.kind == "input":
+                await tui.wait_until(pilot, lambda: app.screen.query("#step-inputs Input"))
+                _fill_inputs(app, app.screen)
+            before = state.current.index
+            app.screen.action_confirm()
+            await tui.wait_until(
+                pilot, lambda before=before: app.runner.state().current.index != before
+            )
+        await tui.wait_until(pilot, lambda: "zero the indicators" in tui.screen_text(app))
+        assert "robot still" not in tui.screen_text(app).lower()

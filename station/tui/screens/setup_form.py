@@ -160,7 +160,9 @@ def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
             ),
             f"limits-{channel}",
         )
-    yield Static(LIMIT_HELP, classes="field-hint")
+    if judged_channels(procedure):
+        # How to write limits, under the limits fields (a gauge study has none to write).
+        yield Static(LIMIT_HELP, classes="field-hint")
     limits_help = _method(procedure).limits_help
     if limits_help:
         # How the method judges these limits (linearity: by each stroke's straightness), said
