@@ -1,8 +1,10 @@
 """``station demo``: a whole procedure against simulated instruments, no hardware.
 
-It starts the procedure's simulator in this process on a pseudo-terminal (three indicators in a
-fixture for repeatability; two fixtures and a teach pendant for relative accuracy; a parallel
-bar with indicators h, v and a linear scale s for linearity), pre-fills the set-up with its port,
+It starts the procedure's simulator in this process on a pseudo-terminal (its method's
+``demo_rig``: three indicators in a fixture for repeatability; two fixtures and a teach pendant
+for relative accuracy; a parallel bar with indicators h, v and a linear scale s for linearity;
+a three-joint arm for per-joint troubleshooting; ... every built-in procedure has one),
+pre-fills the set-up with its port, channel map and trigger,
 and writes the demo's session files to a ``demo`` folder under the sessions folder (said on
 screen). Picking another procedure in the set-up starts that procedure's simulator. All are
 seeded and deterministic. The repeatability robot moves: it leaves the fixture and comes back
@@ -31,13 +33,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "demo",
         help="try a whole procedure against simulated instruments (no hardware)",
-        description="Runs the TUI against a simulated robot on a pseudo-terminal: set-up, "
-        "checklist, captures, verdict. repeatability: a fixture with three dial indicators, "
-        "30 cycles; relative_accuracy: two fixtures and a teach pendant, a few placements; "
-        "linearity: a parallel bar with indicators h, v and a linear scale s, 30 strokes; "
-        "gauge_check: an indicator over a surface plate and a gauge block; gauge_linearity: "
-        "the same indicator and five gauge blocks over its travel; gage_rr: the same indicator, "
-        "ten parts and three appraisers, one reading high and one low. A gauge study the demo runs "
+        description="Runs the TUI against a simulated set-up on a pseudo-terminal: set-up, "
+        "checklist, captures, verdict. Every built-in procedure has its own: repeatability: a "
+        "fixture with three dial indicators, 30 cycles; relative_accuracy: two fixtures and a "
+        "teach pendant, a few placements; linearity: a parallel bar with indicators h, v and a "
+        "linear scale s, 30 strokes; gauge_check: an indicator over a surface plate and a gauge "
+        "block; gauge_linearity: the same indicator and five gauge blocks over its travel; "
+        "gage_rr: the same indicator, ten parts and three appraisers, one reading high and one "
+        "low; joint_troubleshooting: a three-joint arm at the fixture, joint 2 noisy; "
+        "gain_schedule: one joint and the gains its tuning gives at each position; "
+        "pose_characteristics: one fixture at the five poses of the ISO 9283 test cube; "
+        "positioning: a linear scale along an axis with backlash. A gauge study the demo runs "
         "is filed in the demo folder's own gauge register.",
     )
     parser.add_argument(
@@ -50,16 +56,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         default="repeatability",
         metavar="ID",
         help="procedure id: repeatability, relative_accuracy, linearity, gauge_check, "
-        "gauge_linearity or gage_rr each have a simulated set-up; another runs against its "
-        "method's, or "
-        "the repeatability fixture (default: %(default)s)",
+        "gauge_linearity, gage_rr, joint_troubleshooting, gain_schedule, pose_characteristics "
+        "or positioning, each on its own simulated set-up (a site's procedure runs on its "
+        "method's; `station procedures` lists them) (default: %(default)s)",
     )
     parser.add_argument(
         "--count",
         type=int,
         metavar="N",
-        help="cycles (repeatability), fixture placements (relative_accuracy), strokes "
-        "(linearity) or trials (gage_rr) to pre-fill in the set-up (default: the procedure's)",
+        help="what the procedure's set-up counts, pre-filled: cycles (repeatability), fixture "
+        "placements (relative_accuracy), strokes (linearity), trials (gage_rr), joints, "
+        "positions, poses, masters or runs (default: the procedure's)",
     )
     parser.add_argument(
         "--seed", type=int, default=1990, help="simulator seed (default: %(default)s)"
@@ -89,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
     from station.errors import StationError
     from station.session.gauge_register import REGISTER_ENV
     from station.session.store import sessions_folder
-    from station.tui.app import DemoPort, StationApp, StationConfig
+    from station.tui.app import StationApp
     from station.tui.instruments import DemoLab
 
     if args.pace < 0:
@@ -105,28 +112,38 @@ def run(args: argparse.Namespace) -> int:
     os.environ[REGISTER_ENV] = str(folder / "demo" / "gauges.json")
     lab = DemoLab(args.seed, cycle_period=args.cycle_period)
     try:
-        fixture = lab.fixture(procedure.analysis)
-        config = StationConfig(
-            sessions_dir=folder / "demo",
-            # The path above already names the folder: say only why it is this one.
-            sessions_reason=f"the demo's own folder in the sessions folder, {reason}",
-            procedure_dirs=tuple(Path(p) for p in args.procedures),
-            demo=DemoPort(
-                url=fixture.url,
-                protocol=fixture.protocol,
-                channel_map=fixture.channel_map,
-                procedure=args.procedure,
-                description=fixture.description,
-                trigger=fixture.trigger,
-                count=args.count,
-            ),
-            demo_lab=lab,
-            autopilot=args.autopilot,
-            autopilot_pace=args.pace,
-        )
+        config = demo_config(args, procedure, lab, folder, reason)
         return run_app(StationApp(config), mouse=args.mouse)
     finally:
         lab.stop()
+
+
+def demo_config(
+    args: argparse.Namespace, procedure: Any, lab: Any, folder: Path, reason: str
+) -> Any:
+    """The TUI's configuration for the demo of ``procedure``: its own simulated set-up from
+    ``lab`` (a ``DemoLab``) pre-filling the set-up, the session files in ``folder``/demo."""
+    from station.tui.app import DemoPort, StationConfig
+
+    fixture = lab.fixture(procedure.analysis)
+    return StationConfig(
+        sessions_dir=folder / "demo",
+        # The path above already names the folder: say only why it is this one.
+        sessions_reason=f"the demo's own folder in the sessions folder, {reason}",
+        procedure_dirs=tuple(Path(p) for p in args.procedures),
+        demo=DemoPort(
+            url=fixture.url,
+            protocol=fixture.protocol,
+            channel_map=fixture.channel_map,
+            procedure=procedure.id,
+            description=fixture.description,
+            trigger=fixture.trigger,
+            count=args.count,
+        ),
+        demo_lab=lab,
+        autopilot=args.autopilot,
+        autopilot_pace=args.pace,
+    )
 
 
 def _demo_choice(args: argparse.Namespace) -> Any:
@@ -135,7 +152,7 @@ def _demo_choice(args: argparse.Namespace) -> Any:
     import station.methods  # noqa: F401 - procedure files name the methods
     from station.errors import StationError
     from station.procedures import discover_procedures
-    from station.tui.screens.setup_form import DEMO_TRIAL_MINIMUM, count_field
+    from station.tui.screens.setup_form import count_field
 
     catalog = discover_procedures(args.procedures)
     if args.procedure not in catalog.ids():
@@ -145,11 +162,11 @@ def _demo_choice(args: argparse.Namespace) -> Any:
     procedure = catalog.get(args.procedure)
     if args.count is not None:
         count = count_field(procedure)
-        # A demo may be a short trial run (the set-up says the report's range).
-        minimum = min(count.minimum, DEMO_TRIAL_MINIMUM)
-        if args.count < minimum:
+        # A demo may be a short trial run (the set-up says the report's range), but not one
+        # the procedure's method cannot judge.
+        if args.count < count.minimum:
             raise StationError(
                 f"--count {args.count} is too few for {args.procedure}: "
-                f"give at least {minimum} {count.noun}"
+                f"give at least {count.minimum} {count.noun}"
             )
     return procedure

@@ -34,6 +34,7 @@ import math
 import random
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from station.errors import StationError
 from station.instruments.simulator import GaugeSpec, RobotModel, skew_normal_unit
@@ -196,7 +197,7 @@ def faulty_arm(
     *,
     size: float = 4e-5,
     healthy_noise: float = 5e-6,
-    **options: float,
+    **options: Any,
 ) -> JointModel:
     """An arm whose joint ``joint`` (1-based) has one fault: ``backlash`` (lost motion ``size``
     radians), ``noise`` (angular σ ``size``), ``servo`` (a one-sided overshoot of mean ``size``:
@@ -214,7 +215,7 @@ def faulty_arm(
         raise StationError(f"unknown joint fault {fault!r}: use {', '.join(faults)}.")
     joints = [JointFault(noise=healthy_noise)] * JOINTS
     joints[joint - 1] = faults[fault]
-    return JointModel(joints, **options)  # type: ignore[arg-type]
+    return JointModel(joints, **options)
 
 
 JOINT_FAULTS: tuple[str, ...] = ("backlash", "noise", "servo", "encoder")

@@ -205,6 +205,8 @@ class PlacementWords:
         "fixture placements over the envelope; the report asks for a few ({low} to {target})"
     )
     too_few: str = "Give at least 1 fixture placement."
+    fewest: int = 1
+    """The fewest placements the method's analysis can judge (``too_few`` says so)."""
 
 
 # -- charts -----------------------------------------------------------------------------------
@@ -427,7 +429,7 @@ class Method(ABC):
                 "placements",
                 "placements_target",
                 target,
-                1,
+                words.fewest,
                 words.hint.format(low=low, target=target),
                 words.too_few,
             )

@@ -5,15 +5,31 @@ alone (no capability analysis)."""
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from station.analysis.gain_schedule import GainSchedule, fit_schedule
 from station.errors import StationError
-from station.methods.contract import Judgement, Method, MethodInputs
+from station.methods.contract import (
+    DemoDisplay,
+    DemoRig,
+    Judgement,
+    Method,
+    MethodInputs,
+    PlacementWords,
+)
 from station.methods.sessions import is_number
 from station.methods.text import fitted
 from station.procedures import AnalysisNeeds
 from station.session.tables import require_columns
+
+if TYPE_CHECKING:
+    from station.instruments.simulator import GaugeSpec
+
+DEMO_STEP = 50.0
+"""mm between two of the demo joint's positions (the first at 0)."""
+DEMO_GAINS = {"kp": (2.0, -3e-3, 4e-6), "ki": (0.4, 2e-4, 0.0), "kd": (0.07, 0.0, 1e-7)}
+"""The demo's tuned gains as polynomials of the position q (a0, a1, a2): what the tuning at
+each position comes out at."""
 
 
 def gain_inputs(
@@ -67,6 +83,14 @@ class GainScheduleMethod(Method):
         limits=False,
     )
     options = ("order",)
+    placement_words = PlacementWords(
+        label="Positions",
+        noun="positions",
+        hint="positions along the joint's path where the gains are tuned ({low} to {target})",
+        too_few="Give at least 3 positions: the fit chooses its order from 3 or more.",
+        fewest=3,
+    )
+    demo_words = "one joint with a position readout q, the gains tuned at each position"
 
     def batch(self, inputs: MethodInputs) -> Judgement:
         """The fit of each gain against q (``order``: a fixed order, else chosen)."""
@@ -91,6 +115,37 @@ class GainScheduleMethod(Method):
     def count(self, result: Any) -> str:
         """``5 positions``."""
         return f"{len(result.positions)} positions"
+
+    def demo_rig(self, gauge: GaugeSpec, seed: int, *, stroke_points: int) -> DemoRig:
+        """One joint's position readout q (the study takes no readings: the line is there as
+        at the robot), and at each position the gains its tuning comes out at."""
+        from station.instruments.simulator import AxisModel, FixtureModel
+        from station.instruments.simulator import GaugeSpec as Spec
+
+        readout = Spec(0.001, -500.0, 500.0, "mm", 0.0)
+        model = FixtureModel({"q": AxisModel(noise=0.0)}, readout)
+        return DemoRig(
+            model,
+            "a simulated joint with a position readout q and its tuned gains (seeded)",
+            channel_map={"1": "q"},
+            display=_gains_display,
+        )
+
+
+def _gains_display(model: Any, placement: int | None, unit: str) -> DemoDisplay | None:
+    """What the tuning tool shows at ``placement``: the position and the tuned gains."""
+    if placement is None:
+        return None
+    q = DEMO_STEP * (placement - 1)
+    values: dict[str, float] = {"q": q}
+    for name, (a0, a1, a2) in DEMO_GAINS.items():
+        values[name] = float(f"{a0 + a1 * q + a2 * q * q:.6g}")
+    return DemoDisplay(
+        label=f"Tuning tool at position {placement} (simulated)",
+        text="  ".join(f"{name} {value:g}" for name, value in values.items()),
+        values=values,
+        hint="type the position and the gains shown above",
+    )
 
 
 METHOD = GainScheduleMethod()

@@ -12,14 +12,27 @@ import numpy as np
 from station.analysis.joints import analyze_joints
 from station.errors import StationError
 from station.methods.capability import capability_of
-from station.methods.contract import Judgement, Method, MethodInputs
+from station.methods.contract import (
+    DemoDisplay,
+    DemoRig,
+    Judgement,
+    Method,
+    MethodInputs,
+    PlacementWords,
+)
 from station.methods.sessions import AXES, is_number, placement_readings
 from station.methods.text import fitted
 from station.procedures import AnalysisNeeds
 from station.session.tables import require_columns
 
 if TYPE_CHECKING:
+    from station.instruments.simulator import GaugeSpec
     from station.session.tables import ReadingTable
+
+DEMO_FAULTY_JOINT = 2
+"""The joint the demo's arm has a fault in (a noisy servo), for the study to find."""
+DEMO_RETURNS = 25
+"""Returns per joint the demo's arm makes (the procedure's own count)."""
 
 TABLE_COLUMNS = ("joint", "x", "y", "z")
 """The columns of a per-joint CSV (``lever`` optional: the joint's axis to the cube)."""
@@ -74,6 +87,14 @@ class JointTroubleshooting(Method):
         facet_words="a repeat block (one per joint) holding a cycles step",
         channels=AXES,
     )
+    placement_words = PlacementWords(
+        label="Joints",
+        noun="joints",
+        hint="joints moved one at a time, joint 1 at the base first ({low} to {target})",
+        too_few="Give at least 2 joints: the study compares the joints' spreads.",
+        fewest=2,
+    )
+    demo_words = "a three-joint arm at one fixture, one joint noisy"
 
     def batch(self, inputs: MethodInputs) -> Judgement:
         """The joints ranked and the suspect named; the returns pooled for the verdict."""
@@ -98,6 +119,34 @@ class JointTroubleshooting(Method):
     def count(self, result: Any) -> str:
         """``3 joints``."""
         return f"{len(result.joints)} joints"
+
+    def demo_rig(self, gauge: GaugeSpec, seed: int, *, stroke_points: int) -> DemoRig:
+        """A three-joint arm returning to the 3-D fixture one joint at a time, joint 2's servo
+        noisy (the suspect to be found); each joint's turn starts at the taught position,
+        where the station zeroes."""
+        from station.instruments.joint_model import faulty_arm
+
+        model = faulty_arm(
+            DEMO_FAULTY_JOINT, "noise", cycles=DEMO_RETURNS, gauge=gauge, home_readings=1
+        )
+        return DemoRig(
+            model,
+            "a simulated three-joint arm at a fixture with three indicators (seeded)",
+            display=_lever_display,
+        )
+
+
+def _lever_display(model: Any, placement: int | None, unit: str) -> DemoDisplay | None:
+    """What the tape shows for the joint of ``placement``: its axis to the cube."""
+    if placement is None or not 1 <= placement <= len(model.lever_arms()):
+        return None
+    lever = round(model.lever_arms()[placement - 1], 1)
+    return DemoDisplay(
+        label=f"Tape from joint {placement}'s axis to the cube (simulated)",
+        text=f"{lever:g} {unit}",
+        values={"lever": lever},
+        hint="type the lever arm shown above",
+    )
 
 
 METHOD = JointTroubleshooting()

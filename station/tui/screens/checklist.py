@@ -49,7 +49,9 @@ ARRIVAL_ZERO_DOES = (
 )
 ENTER_DOES = {
     "confirm": "Press Enter when this is done.",
-    "zero": "Keep the robot still, then press Enter to zero the indicators.",
+    # Every procedure's zero (a robot at a fixture, an indicator on a surface plate): its
+    # step text says where; this says only what Enter does.
+    "zero": "Keep everything still, then press Enter to zero the indicators.",
     "input": "Type each value: Enter or Tab goes to the next field, Enter in the last one "
     "saves them.",
 }

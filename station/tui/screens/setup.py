@@ -39,6 +39,7 @@ from station.tui.screens.setup_form import (
     KEPT_ON_PROCEDURE_CHANGE,
     TYPED_PORT,
     FormStart,
+    fits_procedure,
     form_rows,
     login_name,
     read_header,
@@ -221,7 +222,8 @@ class SetupScreen(ConnectionTestScreen):
             keys = (
                 KEPT_ON_PROCEDURE_CHANGE[:2] if self.app.config.demo else KEPT_ON_PROCEDURE_CHANGE
             )
-            kept = {key: self.form_value(key) for key in keys}
+            procedure = self.app.catalog.get(str(event.value))
+            kept = fits_procedure({key: self.form_value(key) for key in keys}, procedure)
             self.app.switch_screen(SetupScreen(procedure_id=str(event.value), typed=kept))
 
     def on_descendant_focus(self, event: events.DescendantFocus) -> None:
@@ -394,7 +396,6 @@ class SetupScreen(ConnectionTestScreen):
             setup = read_setup(
                 self.form_value,
                 self._procedure(),
-                demo=self.app.config.demo is not None,
                 operator=login_name(),
                 errors=errors,
             )

@@ -19,7 +19,7 @@ from station.instruments.protocols import get_protocol
 from station.instruments.transport import refuse_own_terminal, url_scheme
 from station.text import LIMIT_HELP, parse_channel_map, parse_limits_text
 from station.tui.remedies import explained
-from station.tui.screens.setup_form import DEMO_TRIAL_MINIMUM, count_field, judged_channels
+from station.tui.screens.setup_form import count_field, judged_channels
 
 if TYPE_CHECKING:
     from station.procedures import Procedure
@@ -92,24 +92,24 @@ def read_limits(value: Value, procedure: Procedure, errors: dict[str, str]) -> d
     return limits
 
 
-def read_count(value: Value, procedure: Procedure, demo: bool, errors: dict[str, str]) -> int:
-    """The cycles, placements or strokes asked for (a refusal under ``cycles``). The demo
-    allows a short trial run (``station demo --count 5``): its verdict comes with the wide
-    confidence bound on Cpk that so few readings give."""
+def read_count(value: Value, procedure: Procedure, errors: dict[str, str]) -> int:
+    """The cycles, placements or strokes asked for (a refusal under ``cycles``). Fewer than the
+    report asks for are a short trial run (``station demo --count 5``): its verdict comes with
+    the wide confidence bound on Cpk that so few readings give. Fewer than the method can
+    judge (a gain schedule's fit from 2 positions) are refused, in the demo too."""
     count = count_field(procedure)
     try:
         asked = int(value("cycles"))
     except ValueError:
         errors["cycles"] = f"Give a whole number of {count.noun}, e.g. {count.target}."
         return 0
-    trial = demo and asked >= DEMO_TRIAL_MINIMUM
-    if asked < count.minimum and not trial:
+    if asked < count.minimum:
         errors["cycles"] = count.too_few
     return asked
 
 
 def read_setup(
-    value: Value, procedure: Procedure, *, demo: bool, operator: str, errors: dict[str, str]
+    value: Value, procedure: Procedure, *, operator: str, errors: dict[str, str]
 ) -> SessionSetup | None:
     """A validated ``SessionSetup``, or None with each fault in ``errors`` under its field id.
     A fault of the whole (``SessionSetup`` refusing the combination) is raised as
@@ -126,7 +126,7 @@ def read_setup(
             f"The resolution must be a positive number such as {procedure.resolution:g}."
         )
     limits = read_limits(value, procedure, errors)
-    asked = read_count(value, procedure, demo, errors)
+    asked = read_count(value, procedure, errors)
     ports = read_ports(value, errors)
     if errors:
         return None

@@ -20,11 +20,12 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal
 from textual.widgets import Label, Select, Static
 
+from station.errors import StationError
 from station.instruments.protocols import protocol_names
 from station.instruments.transport import list_ports
 from station.plain import plain
 from station.session.model import load_session
-from station.text import LIMIT_HELP, channel_map_text, limits_text
+from station.text import LIMIT_HELP, channel_map_text, limits_text, parse_channel_map
 from station.tui.text import shown
 from station.tui.widgets.fields import FieldInput
 
@@ -42,8 +43,6 @@ TRIGGER_CHOICES = (
 TYPED_PORT = "__typed__"
 DEMO_LIMITS = "±0.001"
 """The report's example tolerance, offered in the demo when a procedure has no default limits."""
-DEMO_TRIAL_MINIMUM = 2
-"""The fewest cycles, placements or strokes a demo's trial run may ask for."""
 KEPT_ON_PROCEDURE_CHANGE = ("robot", "operator", "port", "protocol", "map", "trigger")
 
 SelectMaker = Callable[..., Select]
@@ -77,7 +76,8 @@ class FormStart:
 def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
     """The rows of the form, robot to trigger, filled as ``start`` says (a resumed session's
     fields disabled but for the instrument line)."""
-    procedure, header, demo, last = start.procedure, start.header, start.demo, start.last
+    procedure, header, demo = start.procedure, start.header, start.demo
+    last = fits_procedure(start.last, procedure)
     resuming = start.resuming
     catalog_procedures = start.procedures
     count = count_field(procedure)
@@ -160,7 +160,9 @@ def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
             ),
             f"limits-{channel}",
         )
-    yield Static(LIMIT_HELP, classes="field-hint")
+    if judged_channels(procedure):
+        # How to write limits, under the limits fields (a gauge study has none to write).
+        yield Static(LIMIT_HELP, classes="field-hint")
     limits_help = _method(procedure).limits_help
     if limits_help:
         # How the method judges these limits (linearity: by each stroke's straightness), said
@@ -233,6 +235,24 @@ def form_rows(start: FormStart, select: SelectMaker) -> ComposeResult:
         select("trigger", TRIGGER_CHOICES, trigger, disabled=resuming),
         "trigger",
     )
+
+
+def fits_procedure(values: Mapping[str, str], procedure: Procedure) -> dict[str, str]:
+    """``values`` (a remembered set-up, or what was typed for another procedure) without the
+    channel map and trigger that do not fit ``procedure``: a map naming channels it does not
+    have (a repeatability's x, y, z on a gauge check's x), the arrival trigger where the
+    procedure does not pace its cycles by a robot's returns (a gauge on a bench)."""
+    kept = dict(values)
+    try:
+        mapped = set(parse_channel_map(kept.get("map") or kept.get("channel_map")).values())
+    except StationError:
+        mapped = set()  # the operator's own text: F2 says what is wrong with it
+    if not mapped <= set(procedure.channels):
+        kept.pop("map", None)
+        kept.pop("channel_map", None)
+    if kept.get("trigger") == "arrival" and procedure.trigger != "arrival":
+        kept.pop("trigger")
+    return kept
 
 
 def _method(procedure: Procedure) -> Any:
