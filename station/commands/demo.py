@@ -160,6 +160,16 @@ def _demo_choice(args: argparse.Namespace) -> Any:
             f"no procedure {args.procedure!r}; choose one of {', '.join(catalog.ids())}"
         )
     procedure = catalog.get(args.procedure)
+    from station.tui.instruments import demo_methods
+
+    if procedure.analysis not in demo_methods():
+        # Its readings would come from another method's simulator: a demo of nothing.
+        raise StationError(
+            f"{args.procedure} has no simulated set-up in the demo yet: run it headless "
+            f"against `station simulate` with `station capture --procedure {args.procedure}` "
+            "(procedures/README.md), or choose one of "
+            + ", ".join(i for i in catalog.ids() if catalog.get(i).analysis in demo_methods())
+        )
     if args.count is not None:
         count = count_field(procedure)
         # A demo may be a short trial run (the set-up says the report's range), but not one

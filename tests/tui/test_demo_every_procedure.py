@@ -21,13 +21,24 @@ from station.errors import StationError
 from station.procedures import discover_procedures
 from station.tui.app import StationApp
 from station.tui.autopilot import run_autopilot
-from station.tui.instruments import DemoLab
+from station.tui.instruments import DemoLab, demo_methods
 from station.tui.screens.setup import SetupScreen
 from station.tui.screens.setup_form import count_field
 from station.tui.screens.summary import SummaryScreen
 
 CATALOG = discover_procedures(())
-PROCEDURES = list(CATALOG.ids())
+# Every built-in procedure whose method the demo simulates; the others are refused (below).
+PROCEDURES = [i for i in CATALOG.ids() if CATALOG.get(i).analysis in demo_methods()]
+WITHOUT_DEMO = [i for i in CATALOG.ids() if i not in PROCEDURES]
+
+
+@pytest.mark.parametrize("procedure", WITHOUT_DEMO or ["stabilisation"])
+def test_a_procedure_without_a_simulated_set_up_is_refused_with_a_sentence(procedure: str) -> None:
+    """Never a demo on another method's simulator: the sentence says how to run it instead."""
+    if procedure not in CATALOG.ids() or procedure in PROCEDURES:
+        pytest.skip(f"{procedure} is not a built-in procedure without a demo any more")
+    with pytest.raises(StationError, match="no simulated set-up in the demo yet"):
+        demo._demo_choice(demo_args(procedure))
 
 
 def short_count(procedure: str) -> int:
